@@ -1,0 +1,128 @@
+"""`suds-exp`: the command-line face of the suds_exp library.
+
+Each command parses options and calls one library function; the work lives in
+`suds_exp`. User errors (`SudsError`) print one line and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from suds_exp import console
+from suds_exp.errors import SudsError
+from suds_exp.store import Store, default_db_path
+
+app = typer.Typer(
+    name="suds-exp",
+    help="Learn the motility map of an under-actuated robot from motion capture, "
+    "and run the paper's bootstrap experiment on it.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+DbOption = Annotated[
+    Path | None,
+    typer.Option("--db", envvar="SUDS_DB", help="DuckDB file [default: ./suds.duckdb]."),
+]
+JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
+QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
+
+
+def command(*args, **kwargs):
+    """`app.command` that turns a `SudsError` into one line on stderr and exit code 2."""
+
+    def wrap(fn):
+        @functools.wraps(fn)
+        def run(*a, **kw):
+            try:
+                return fn(*a, **kw)
+            except SudsError as exc:
+                console.err.print(f"[red]error:[/red] {exc}", markup=True, highlight=False)
+                raise typer.Exit(2) from None
+
+        return app.command(*args, **kwargs)(run)
+
+    return wrap
+
+
+def open_store(db: Path | None) -> Store:
+    return Store(db if db is not None else default_db_path())
+
+
+@command()
+def init(db: DbOption = None) -> None:
+    """Create the database, or upgrade it to the latest schema."""
+    store = open_store(db)
+    applied = store.upgrade()
+    console.out.print(
+        f"{store.path}: " + (f"applied {', '.join(applied)}" if applied else "up to date")
+    )
+
+
+@command()
+def ingest(
+    paths: Annotated[list[Path] | None, typer.Argument(help="Capture files or folders.")] = None,
+    manifest: Annotated[
+        Path | None, typer.Option(help="CSV file,gait,frequency_hz,repeat,notes.")
+    ] = None,
+    layout: Annotated[Path | None, typer.Option(help="CSV role,marker for the 11 roles.")] = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Ingest QTM TSV exports, C3D files or marker CSVs (each file in one transaction).
+
+    Example: suds-exp ingest data/ --manifest data/manifest.csv
+    """
+    from suds_exp.ingest import ingest_paths
+
+    results = ingest_paths(open_store(db), paths or [], manifest, layout, progress=not (quiet or json_))
+    if json_:
+        console.print_json(
+            [{"file": str(r.path), "status": r.status, "trial_id": r.trial_id} for r in results]
+        )
+        return
+    for r in results:
+        console.out.print(("ingested " if r.status == "ingested" else "skipped ") + r.message)
+
+
+@command()
+def trials(db: DbOption = None, json_: JsonOption = False) -> None:
+    """List the trials and their conditions."""
+    from suds_exp.ingest import list_trials
+
+    frame = list_trials(open_store(db))
+    if json_:
+        console.print_json(frame)
+    else:
+        shown = frame.drop(columns=["source_file", "ingested_at"])
+        shown.insert(1, "file", frame.source_file.map(lambda p: Path(p).name))
+        console.print_frame(shown, title="trials")
+
+
+@command()
+def sql(
+    query: Annotated[str, typer.Argument(help="SQL to run on a read-only connection.")],
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Run a read-only SQL query and print the result; statements that write are refused.
+
+    Example: suds-exp sql "SELECT gait, count(*) FROM trials GROUP BY gait"
+    """
+    from suds_exp.store import run_readonly
+
+    frame = run_readonly(open_store(db), query)
+    if json_:
+        console.print_json(frame)
+    else:
+        console.print_frame(frame)
+
+
+if __name__ == "__main__":
+    app()

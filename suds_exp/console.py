@@ -1,0 +1,44 @@
+"""Terminal output shared by the CLI commands: tables, JSON, messages."""
+
+from __future__ import annotations
+
+import json
+import sys
+from typing import Any
+
+import pandas as pd
+from rich.console import Console
+from rich.table import Table
+
+from suds_exp.store.sql import frame_to_json
+
+out = Console(highlight=False, soft_wrap=True)
+err = Console(stderr=True, highlight=False, soft_wrap=True)
+
+
+def print_frame(frame: pd.DataFrame, title: str | None = None, max_rows: int = 200) -> None:
+    """Print a DataFrame as a rich table (first ``max_rows`` rows)."""
+    table = Table(title=title, show_lines=False)
+    for column in frame.columns:
+        table.add_column(str(column), overflow="fold")
+    for row in frame.head(max_rows).itertuples(index=False):
+        table.add_row(*("" if pd.isna(v) is True else _fmt(v) for v in row))
+    out.print(table)
+    if len(frame) > max_rows:
+        out.print(f"... {len(frame) - max_rows} more rows")
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return str(value)
+
+
+def print_json(document: Any) -> None:
+    """Print one JSON document on stdout (a DataFrame becomes a list of row objects)."""
+    if isinstance(document, pd.DataFrame):
+        text = frame_to_json(document)
+    else:
+        text = json.dumps(document, default=str, indent=None)
+    sys.stdout.write(text + "\n")
+    sys.stdout.flush()

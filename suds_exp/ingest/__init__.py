@@ -1,0 +1,24 @@
+"""Mocap ingest: QTM TSV, C3D and CSV readers, manifest, marker layout."""
+
+from suds_exp.ingest.capture import Capture
+from suds_exp.ingest.layout import DEFAULT_LAYOUT, ROLES, read_layout, trial_layout
+from suds_exp.ingest.listing import list_trials
+from suds_exp.ingest.load import IngestResult, ingest_file, ingest_paths
+from suds_exp.ingest.manifest import GAITS, Condition, read_manifest
+from suds_exp.ingest.readers import read_capture
+
+__all__ = [
+    "Capture",
+    "Condition",
+    "DEFAULT_LAYOUT",
+    "GAITS",
+    "IngestResult",
+    "ROLES",
+    "ingest_file",
+    "ingest_paths",
+    "list_trials",
+    "read_capture",
+    "read_layout",
+    "read_manifest",
+    "trial_layout",
+]

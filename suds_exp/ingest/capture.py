@@ -1,0 +1,113 @@
+"""`Capture`: what every reader returns, and the checks every capture must pass."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.errors import IngestError
+
+
+@dataclass
+class Capture:
+    """One motion-capture recording, in the same form whatever file it came from.
+
+    Attributes
+    ----------
+    path : Path
+        The file it was read from.
+    format : str
+        ``"qtm-tsv"``, ``"c3d"`` or ``"csv"``.
+    sample_rate_hz : float
+        Capture rate, Hz.
+    marker_names : list of str
+        The capture's own marker names, in file order.
+    frame : array of shape (n_frames,), int
+        Frame numbers as in the file.
+    t : array of shape (n_frames,), s
+        Sample times.
+    xyz : array of shape (n_frames, n_markers, 3), mm
+        Marker positions; NaN where the marker was not seen.
+    """
+
+    path: Path
+    format: str
+    sample_rate_hz: float
+    marker_names: list[str]
+    frame: np.ndarray
+    t: np.ndarray
+    xyz: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.frame)
+
+    def validate(self) -> Capture:
+        """Raise `IngestError` unless the capture is complete and ordered in time."""
+        name = self.path
+        if self.n_frames == 0:
+            raise IngestError(f"{name}: the file holds no frames")
+        if len(set(self.marker_names)) != len(self.marker_names):
+            dup = pd.Series(self.marker_names)
+            raise IngestError(
+                f"{name}: marker name {dup[dup.duplicated()].iloc[0]!r} appears twice"
+            )
+        for label, values in (("frame", self.frame), ("time", self.t)):
+            if not np.all(np.isfinite(values)):
+                raise IngestError(f"{name}: {label} column has a missing value")
+            steps = np.diff(values)
+            bad = np.flatnonzero(steps <= 0)
+            if bad.size:
+                i = int(bad[0]) + 1
+                raise IngestError(
+                    f"{name}: {label} values must increase strictly; data row {i + 1} "
+                    f"({label} {values[i]:g}) does not follow {values[i - 1]:g}"
+                )
+        if not np.isfinite(self.sample_rate_hz) or self.sample_rate_hz <= 0:
+            raise IngestError(f"{name}: sample rate must be a positive number of Hz")
+        if self.xyz.shape != (self.n_frames, len(self.marker_names), 3):
+            raise IngestError(
+                f"{name}: expected {len(self.marker_names)} markers x 3 coordinates per frame"
+            )
+        return self
+
+    def long_frame(self, trial_id: int) -> pd.DataFrame:
+        """The capture as rows of the ``markers`` table (trial, frame, t, marker, x, y, z)."""
+        n_f, n_m = self.n_frames, len(self.marker_names)
+        xyz = self.xyz.reshape(n_f * n_m, 3)
+        missing = ~np.all(np.isfinite(xyz), axis=1)
+        xyz = np.where(missing[:, None], np.nan, xyz)
+        return pd.DataFrame(
+            {
+                "trial_id": np.full(n_f * n_m, trial_id, dtype=np.int32),
+                "frame": np.repeat(self.frame.astype(np.int32), n_m),
+                "t": np.repeat(self.t.astype(float), n_m),
+                "marker": np.tile(np.asarray(self.marker_names, dtype=object), n_f),
+                "x": xyz[:, 0],
+                "y": xyz[:, 1],
+                "z": xyz[:, 2],
+                "missing": missing,
+            }
+        )
+
+
+def parse_numeric_block(path: Path, cells: pd.DataFrame, first_line: int, columns: list[str]) -> np.ndarray:
+    """Convert a block of text cells to floats; empty cells become NaN.
+
+    ``first_line`` is the 1-based file line of the block's first row, so an error can
+    name the line and column of the first cell that is not a number.
+    """
+    stripped = cells.apply(lambda c: c.str.strip())
+    values = stripped.apply(pd.to_numeric, errors="coerce")
+    bad = values.isna() & (stripped != "")
+    if bad.to_numpy().any():
+        row, col = np.argwhere(bad.to_numpy())[0]
+        raise IngestError(
+            f"{path}: line {first_line + row}, column {columns[col]!r}: expected a number, "
+            f"got {stripped.iat[row, col]!r}"
+        )
+    return values.to_numpy(dtype=float)

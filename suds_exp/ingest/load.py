@@ -1,0 +1,158 @@
+"""Ingest capture files into the store: one transaction per file."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import sqlalchemy as sa
+
+from suds_exp.errors import IngestError
+from suds_exp.ingest.layout import check_layout, layout_json, read_layout
+from suds_exp.ingest.manifest import Condition, read_manifest
+from suds_exp.ingest.readers import READERS, read_capture
+from suds_exp.progress import progress_bar
+from suds_exp.store import Store
+from suds_exp.store.tables import markers, trials
+
+
+@dataclass(frozen=True)
+class IngestResult:
+    """What happened to one file: ``status`` is ``"ingested"`` or ``"skipped"``."""
+
+    path: Path
+    status: str
+    trial_id: int
+    n_frames: int
+    message: str
+
+
+def expand_paths(paths: list[Path], exclude: set[Path]) -> list[Path]:
+    """Files as given, and the capture files (by extension) inside given folders."""
+    files: list[Path] = []
+    for path in paths:
+        path = Path(path)
+        if path.is_dir():
+            found = sorted(
+                p for p in path.rglob("*") if p.is_file() and p.suffix.lower() in READERS
+            )
+            files.extend(p for p in found if p.resolve() not in exclude)
+        else:
+            files.append(path)
+    return files
+
+
+def _same_condition(condition: Condition):
+    return sa.and_(
+        trials.c.gait == condition.gait,
+        sa.func.round(trials.c.frequency_hz, 6) == round(condition.frequency_hz, 6),
+        trials.c.repeat == condition.repeat,
+    )
+
+
+def ingest_file(
+    store: Store,
+    path: Path,
+    condition: Condition | None = None,
+    layout: dict[str, str] | None = None,
+    layout_source: str = "layout",
+) -> IngestResult:
+    """Read, validate and store one capture file in one transaction.
+
+    A file whose content hash is already stored is skipped. Raises `IngestError` (and
+    writes nothing) for a bad file, a layout naming markers the file lacks, or a
+    condition already taken by a different capture.
+    """
+    capture, digest = read_capture(path)
+    if layout is not None:
+        check_layout(layout, capture.marker_names, layout_source, path)
+    with store.write() as conn:
+        existing = conn.execute(
+            sa.select(trials.c.id).where(trials.c.content_hash == digest)
+        ).scalar_one_or_none()
+        if existing is not None:
+            return IngestResult(
+                path, "skipped", existing, capture.n_frames,
+                f"{path}: already ingested as trial {existing} (same content); nothing done",
+            )
+        if condition is not None:
+            clash = conn.execute(
+                sa.select(trials.c.id, trials.c.source_file).where(_same_condition(condition))
+            ).first()
+            if clash is not None:
+                raise IngestError(
+                    f"{path}: condition gait={condition.gait} frequency_hz="
+                    f"{condition.frequency_hz:g} repeat={condition.repeat} is already trial "
+                    f"{clash.id} ({clash.source_file}) with different content"
+                )
+        trial_id = conn.execute(
+            sa.insert(trials)
+            .values(
+                source_file=str(Path(path).resolve()),
+                content_hash=digest,
+                format=capture.format,
+                gait=condition.gait if condition else None,
+                frequency_hz=condition.frequency_hz if condition else None,
+                repeat=condition.repeat if condition else None,
+                sample_rate_hz=capture.sample_rate_hz,
+                n_frames=capture.n_frames,
+                marker_names=list(capture.marker_names),
+                layout=layout_json(layout),
+                ingested_at=sa.func.current_timestamp(),
+                notes=condition.notes if condition else None,
+            )
+            .returning(trials.c.id)
+        ).scalar_one()
+        store.insert_df(conn, markers.name, capture.long_frame(trial_id))
+    label = (
+        f"{condition.gait} {condition.frequency_hz:g} Hz #{condition.repeat}" if condition else "no condition"
+    )
+    return IngestResult(
+        path, "ingested", trial_id, capture.n_frames,
+        f"{path}: trial {trial_id}, {capture.n_frames} frames, {len(capture.marker_names)} markers ({label})",
+    )
+
+
+def ingest_paths(
+    store: Store,
+    paths: list[Path],
+    manifest: Path | None = None,
+    layout: Path | None = None,
+    progress: bool = True,
+) -> list[IngestResult]:
+    """Ingest capture files and folders, each file in its own transaction.
+
+    Parameters
+    ----------
+    store : Store
+    paths : list of Path
+        Capture files (``.tsv`` QTM export, ``.c3d``, ``.csv``) or folders to search.
+        When empty, the files the manifest lists are ingested.
+    manifest : Path, optional
+        CSV ``file,gait,frequency_hz,repeat,notes`` assigning conditions; a file with no
+        row is ingested with no condition.
+    layout : Path, optional
+        CSV ``role,marker`` mapping the capture's marker names to the robot's roles.
+    progress : bool
+        Show a progress bar when there is more than one file.
+
+    The manifest and layout are checked before any file is read. The first bad file
+    stops the run with an `IngestError`; files before it stay ingested.
+    """
+    conditions = read_manifest(manifest) if manifest is not None else {}
+    roles = read_layout(layout) if layout is not None else None
+    exclude = {Path(p).resolve() for p in (manifest, layout) if p is not None}
+    files = expand_paths(list(paths), exclude) if paths else sorted(conditions)
+    if not files:
+        raise IngestError("nothing to ingest: give capture files, folders or --manifest")
+    results = []
+    with progress_bar("Ingesting", total=len(files), enabled=progress and len(files) > 1) as advance:
+        for path in files:
+            results.append(
+                ingest_file(
+                    store, path, conditions.get(Path(path).resolve()), roles,
+                    str(layout) if layout else "layout",
+                )
+            )
+            advance()
+    return results

@@ -1,0 +1,76 @@
+"""Manifest CSV: which gait, frequency and repeat each capture file is.
+
+Columns ``file,gait,frequency_hz,repeat,notes``; ``file`` is relative to the
+manifest's folder (or absolute); ``frequency_hz`` may be a decimal or a fraction
+(``1/3``); ``notes`` may be empty.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+import pandas as pd
+
+from suds_exp.errors import IngestError
+
+GAITS = ("S+", "S-", "O", "D-", "D+")
+COLUMNS = ("file", "gait", "frequency_hz", "repeat", "notes")
+
+
+@dataclass(frozen=True)
+class Condition:
+    """The experimental condition of one capture."""
+
+    gait: str
+    frequency_hz: float
+    repeat: int
+    notes: str | None = None
+
+
+def parse_frequency(text: str) -> float:
+    """``"0.5"`` or ``"1/3"`` -> Hz as a float; raises ValueError on anything else."""
+    value = float(Fraction(text.strip()))
+    if value <= 0:
+        raise ValueError("non-positive")
+    return value
+
+
+def read_manifest(path: Path) -> dict[Path, Condition]:
+    """Resolved file path -> `Condition` for every row of the manifest at ``path``."""
+    path = Path(path)
+    if not path.is_file():
+        raise IngestError(f"{path}: manifest file not found")
+    try:
+        table = pd.read_csv(path, dtype=str, keep_default_na=False)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError):
+        raise IngestError(f"{path}: expected a CSV with columns {','.join(COLUMNS)}") from None
+    table.columns = [c.strip() for c in table.columns]
+    lacking = [c for c in COLUMNS[:4] if c not in table.columns]
+    if lacking:
+        raise IngestError(f"{path}: line 1: manifest lacks column(s) {', '.join(lacking)}")
+    out: dict[Path, Condition] = {}
+    for i, row in enumerate(table.itertuples(index=False), start=2):
+        where = f"{path}: line {i}"
+        file = (path.parent / row.file.strip()).resolve()
+        if not file.is_file():
+            raise IngestError(f"{where}: file {row.file.strip()!r} does not exist")
+        gait = row.gait.strip()
+        if gait not in GAITS:
+            raise IngestError(f"{where}: unknown gait {gait!r}; expected one of {', '.join(GAITS)}")
+        try:
+            freq = parse_frequency(row.frequency_hz)
+        except (ValueError, ZeroDivisionError):
+            raise IngestError(
+                f"{where}: frequency_hz {row.frequency_hz!r}: expected a positive number of Hz"
+            ) from None
+        try:
+            repeat = int(row.repeat.strip())
+        except ValueError:
+            raise IngestError(f"{where}: repeat {row.repeat!r}: expected a whole number") from None
+        if file in out:
+            raise IngestError(f"{where}: file {row.file.strip()!r} is listed twice")
+        notes = getattr(row, "notes", "").strip() or None
+        out[file] = Condition(gait, freq, repeat, notes)
+    return out

@@ -1,0 +1,56 @@
+"""Dispatch from a file's extension to its reader."""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable
+from pathlib import Path
+
+from suds_exp.errors import IngestError
+from suds_exp.ingest.c3d_reader import read_c3d
+from suds_exp.ingest.capture import Capture
+from suds_exp.ingest.csv_reader import read_marker_csv
+from suds_exp.ingest.qtm import read_qtm_tsv
+
+
+def _text(path: Path, data: bytes) -> str:
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        try:
+            return data.decode("latin-1")
+        except UnicodeDecodeError:  # pragma: no cover - latin-1 decodes any byte
+            raise IngestError(f"{path}: expected a text file") from None
+
+
+#: extension -> (format name, reader of the file's bytes)
+READERS: dict[str, tuple[str, Callable[[Path, bytes], Capture]]] = {
+    ".tsv": ("qtm-tsv", lambda p, b: read_qtm_tsv(p, _text(p, b))),
+    ".c3d": ("c3d", read_c3d),
+    ".csv": ("csv", lambda p, b: read_marker_csv(p, _text(p, b))),
+}
+
+
+def capture_formats() -> list[str]:
+    """The file extensions ingest understands."""
+    return sorted(READERS)
+
+
+def read_capture(path: Path) -> tuple[Capture, str]:
+    """Read and validate one capture file; return it with the SHA-256 of its bytes."""
+    path = Path(path)
+    if not path.exists():
+        raise IngestError(f"{path}: no such file")
+    if not path.is_file():
+        raise IngestError(f"{path}: not a file")
+    suffix = path.suffix.lower()
+    if suffix not in READERS:
+        raise IngestError(
+            f"{path}: unknown format {suffix or '(no extension)'!r}; expected one of "
+            + ", ".join(capture_formats())
+        )
+    data = path.read_bytes()
+    if not data.strip():
+        raise IngestError(f"{path}: the file is empty")
+    capture = READERS[suffix][1](path, data).validate()
+    return capture, hashlib.sha256(data).hexdigest()

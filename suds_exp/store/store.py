@@ -1,0 +1,116 @@
+"""`Store`: the one DuckDB file every step reads from and writes to."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+import sqlalchemy as sa
+
+from suds_exp.errors import StoreError
+from suds_exp.store import migrate
+from suds_exp.store.engine import default_db_path, make_engine, retry_on_lock
+
+_frame_names = itertools.count()
+
+
+class Store:
+    """A DuckDB database file, opened only for the length of each block.
+
+    Parameters
+    ----------
+    path : path-like, optional
+        The database file; ``$SUDS_DB`` or ``./suds.duckdb`` when None.
+
+    ``with store.write() as conn`` gives a SQLAlchemy connection inside one transaction
+    (committed when the block ends, rolled back if it raises) after applying pending
+    migrations; ``with store.read() as conn`` gives a read-only one. Both wait briefly
+    when another process holds the file.
+    """
+
+    def __init__(self, path: str | Path | None = None):
+        self.path = Path(path) if path is not None else default_db_path()
+        self._migrated = False
+
+    def __repr__(self) -> str:
+        return f"Store({str(self.path)!r})"
+
+    # -- connections ---------------------------------------------------------------
+    def upgrade(self, target: int | None = None) -> list[str]:
+        """Create the file if needed and apply pending migrations; return their names."""
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        engine = make_engine(self.path)
+        try:
+            applied = retry_on_lock(lambda: migrate.upgrade(engine, target), self.path)
+        finally:
+            engine.dispose()
+        if target is None:
+            self._migrated = True
+        return applied
+
+    @contextmanager
+    def write(self) -> Iterator[sa.Connection]:
+        """A connection in one transaction; the file is held only inside the block."""
+        if not self._migrated:
+            self.upgrade()
+        engine = make_engine(self.path)
+        try:
+            conn = retry_on_lock(engine.connect, self.path)
+            with conn, conn.begin():
+                yield conn
+        finally:
+            engine.dispose()
+
+    @contextmanager
+    def read(self) -> Iterator[sa.Connection]:
+        """A read-only connection; refuses a file that does not exist."""
+        if not self.path.exists():
+            raise StoreError(f"{self.path}: no database here; create one with `suds-exp init`")
+        engine = make_engine(self.path, read_only=True)
+        try:
+            conn = retry_on_lock(engine.connect, self.path)
+            with conn:
+                yield conn
+        finally:
+            engine.dispose()
+
+    # -- bulk data -------------------------------------------------------------------
+    @staticmethod
+    def insert_df(conn: sa.Connection, table: str, df: pd.DataFrame) -> int:
+        """Insert ``df`` into ``table`` by column name through DuckDB's native path.
+
+        Runs inside ``conn``'s transaction; returns the number of rows inserted.
+        """
+        if df.empty:
+            return 0
+        raw = conn.connection.driver_connection
+        name = f"_suds_frame_{next(_frame_names)}"
+        raw.register(name, df)
+        try:
+            conn.exec_driver_sql(f'INSERT INTO "{table}" BY NAME SELECT * FROM "{name}"')
+        finally:
+            raw.unregister(name)
+        return len(df)
+
+    @staticmethod
+    def frame(conn: sa.Connection, query: Any, params: Sequence | Mapping | None = None) -> pd.DataFrame:
+        """Run ``query`` on ``conn`` and return a DataFrame through DuckDB's Arrow path.
+
+        ``query`` is a SQLAlchemy Core statement (its bound parameters are used) or SQL
+        text with DuckDB parameters (``?`` / ``$1`` / ``$name``) given in ``params``.
+        """
+        raw = conn.connection.driver_connection
+        if isinstance(query, sa.sql.ClauseElement):
+            compiled = query.compile(dialect=conn.dialect)
+            values = [compiled.params[k] for k in compiled.positiontup or []]
+            return raw.execute(str(compiled), values).df()
+        return raw.execute(query, params or []).df()
+
+    def query_df(self, query: Any, params: Sequence | Mapping | None = None) -> pd.DataFrame:
+        """Run ``query`` on a read-only connection and return a DataFrame."""
+        with self.read() as conn:
+            return self.frame(conn, query, params)
