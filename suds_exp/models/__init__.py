@@ -1,0 +1,64 @@
+"""The five learners of the paper, built by name with `make_model`.
+
+| name         | class                          | learns                                   |
+|--------------|--------------------------------|------------------------------------------|
+| `phase-only` | `phase_only.PhaseOnly`         | v_b(phase), Fourier series               |
+| `TLS`        | `tls.TLS`                      | phase-binned TLS of v_b on r_a offsets   |
+| `TLS+SUDS`   | `tls.TLSSuds`                  | the same on (r_a, r_p) + dr_p/dt         |
+| `GMR`        | `agbr.GMR`                     | A-GBR of v_b on (r_a, dr_a/dt)           |
+| `GMR+SUDS`   | `agbr.GMRSuds`                 | A-GBR of (v_b, dr_p/dt) on (r_a, r_p, dr_a/dt) |
+
+Every learner is a scikit-learn estimator: `fit(samples) -> self`,
+`predict(samples) -> DataFrame[vx, vy, wz(, drp_1..drp_k)]` with the input's index.
+"""
+
+from __future__ import annotations
+
+from suds_exp.errors import ConfigError
+from suds_exp.models.agbr import GMR, GMRSuds
+from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.phase_only import PhaseOnly
+from suds_exp.models.tls import TLS, TLSSuds
+
+MODELS: dict[str, type[Learner]] = {
+    "phase-only": PhaseOnly,
+    "TLS": TLS,
+    "TLS+SUDS": TLSSuds,
+    "GMR": GMR,
+    "GMR+SUDS": GMRSuds,
+}
+MODEL_NAMES = tuple(MODELS)
+
+
+def make_model(name: str, **params) -> Learner:
+    """A new, unfitted learner by name (see MODEL_NAMES) with the given hyper-parameters.
+
+    Unknown names or parameters raise ConfigError; parameter values are checked by `fit`.
+    """
+    try:
+        cls = MODELS[name]
+    except KeyError:
+        raise ConfigError(
+            f"unknown model {name!r}; expected one of {', '.join(MODEL_NAMES)}"
+        ) from None
+    valid = cls().get_params()
+    bad = [p for p in params if p not in valid]
+    if bad:
+        raise ConfigError(
+            f"model {name}: unknown parameter(s) {', '.join(bad)}; "
+            f"valid: {', '.join(sorted(valid))}"
+        )
+    return cls(**params)
+
+
+__all__ = [
+    "MODELS",
+    "MODEL_NAMES",
+    "ModelError",
+    "make_model",
+    "GMR",
+    "GMRSuds",
+    "TLS",
+    "TLSSuds",
+    "PhaseOnly",
+]

@@ -1,0 +1,376 @@
+"""GMR and GMR+SUDS: augmented Gaussian branching regression (A-GBR, Hu & Revzen 2025).
+
+The paper names the ingredients but publishes no equations or code; this is our design.
+
+Regression. A full-covariance Gaussian mixture (K = `n_components`, EM in
+`suds_exp.models.mixture`) is fitted to the joint vectors z = (x, y), with
+x = (r_a, dr_a/dt), y = v_b for GMR and x = (r_a, r_p, dr_a/dt), y = (v_b, dr_p/dt) for
+GMR+SUDS (dr_p/dt is not needed on the right-hand side, Bittner et al. 2022). Every
+column is standardised with the training mean and standard deviation. The prediction is
+the responsibility-weighted sum of the components' affine conditional means,
+E[y | x] = sum_k h_k(x) (mu_y,k + S_yx,k S_xx,k^-1 (x - mu_x,k)), with gates
+h_k(x) proportional to pi_k N(x | mu_x,k, S_xx,k).
+
+Augmentation (`augment="dilation"`). The physics is rate-independent: time-rescaling a
+motion by s scales every rate (dr_a/dt, v_b, dr_p/dt) by s and leaves the shapes alone,
+so v_b is homogeneous of degree 1 in dr_a/dt (not linear: friction may depend on the
+direction of motion, which is why we do not add mirrored, s < 0, copies). Each training
+sample gets `augment_copies` dilated copies (r, s dr/dt, s v_b[, s dr_p/dt]) with s drawn
+log-uniformly from `augment_range`, entering EM with sample weight `augment_weight`
+(originals weigh 1). The mixture then spreads each component along rays through
+dr_a/dt = 0, whose affine conditional mean is then (near) linear in dr_a/dt: a bias
+towards linearity in dr_a/dt whose strength is the weight and whose reach is the range.
+It is what lets a model trained at one gait frequency predict another.
+
+Branching (`branching="filter"`). The map may be multi-valued: at one (r_a, dr_a/dt) the
+body may move differently depending on recent history (e.g. flippers open or closed).
+The mixture components act as branches; from the training trials (consecutive samples of
+one trial, joint-space responsibilities gamma) we learn a transition matrix
+T_jk ~ sum_t gamma_t-1,j gamma_t,k, blended with the priors, T = (1 - branch_mix) T +
+branch_mix 1 pi^T, so no branch is ever unreachable. Prediction runs a forward filter
+per trial: alpha_t,k ~ N(x_t | mu_x,k, S_xx,k) (alpha_t-1 T)_k, started at the priors,
+and uses alpha_t in place of the gates h_k(x_t): the branch the system was on a moment
+ago (how it got here) selects among components that explain x_t equally well.
+`branching="none"` is plain GMR gating. Samples must be time-ordered within a trial at
+the training sample spacing (the campaign decimates every condition to the same samples
+per cycle).
+
+Rollout (GMR+SUDS, mode="rollout"): r_p starts at each trial's first measured value and
+is integrated by explicit Euler with the predicted dr_p/dt, clipped to the training range
+widened by half its width; v_b is predicted from the rolled-out r_p.
+
+Choosing K: `select_k="bic"` fits every K in `k_candidates` and keeps the lowest BIC
+(weighted log-likelihood, augmented samples counted with their weight); off by default
+so the cost of a campaign is predictable.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.errors import ConfigError
+from suds_exp.models.base import (
+    DRA_COLUMNS,
+    RA_COLUMNS,
+    VB_COLUMNS,
+    Learner,
+    ModelError,
+    TimeSeries,
+    as_array,
+    check_choice,
+    check_float,
+    check_int,
+    passive_columns,
+    require_columns,
+)
+from suds_exp.models.mixture import Conditional, fit_mixture, responsibilities
+
+
+def forward_filter(log_emit, transition, priors, first) -> np.ndarray:
+    """Filtered branch probabilities alpha, shape (n, K), for time-ordered samples.
+
+    log_emit (n, K): log N(x_t | component k); transition (K, K), rows sum to 1;
+    priors (K,); first (n,) bool marks the first sample of each trial (restart).
+    """
+    e = np.exp(log_emit - log_emit.max(axis=1, keepdims=True))
+    out = np.empty_like(e)
+    a = priors
+    for t in range(len(e)):
+        a = e[t] * (priors if first[t] else a @ transition)
+        s = a.sum()
+        a = a / s if s > 0 else e[t] * priors / (e[t] @ priors)
+        out[t] = a
+    return out
+
+
+class GMR(Learner):
+    """A-GBR of v_b on (r_a, dr_a/dt) (see the module docstring for the design).
+
+    Parameters
+    ----------
+    n_components : int, default 12
+        Number of Gaussian components K.
+    reg_covar : float, default 1e-3
+        Added to each covariance diagonal (standardised units).
+    max_iter : int, default 60
+        EM iteration limit.
+    tol : float, default 1e-3
+        EM stops when the mean log-likelihood per sample improves by less than this.
+    augment : {"dilation", "none"}, default "dilation"
+    augment_range : tuple of two floats, default (0.5, 2.0)
+        Range of dilation factors s (log-uniform).
+    augment_copies : int, default 1
+        Dilated copies per training sample.
+    augment_weight : float, default 0.5
+        EM sample weight of each dilated copy (originals weigh 1).
+    branching : {"filter", "none"}, default "filter"
+    branch_mix : float, default 0.1
+        Weight of the priors blended into the learned branch transition matrix.
+    select_k : {"none", "bic"}, default "none"
+    k_candidates : tuple of int, default (4, 8, 12, 16)
+        Candidates for K when select_k="bic".
+    random_state : int, default 0
+        Seed of the k-means++ initialisation and of the dilation factors.
+
+    Attributes
+    ----------
+    priors_ (K,), means_ (K, D), covariances_ (K, D, D): the mixture in standardised
+    units over columns `columns_in_ + columns_out_`; `center_`, `scale_` (D,) the
+    standardisation; `transition_` (K, K) the branch transition matrix; `n_iter_`,
+    `converged_`, `n_components_` (K actually used).
+    """
+
+    name = "GMR"
+
+    def __init__(
+        self,
+        n_components: int = 12,
+        reg_covar: float = 1e-3,
+        max_iter: int = 60,
+        tol: float = 1e-3,
+        augment: str = "dilation",
+        augment_range: tuple = (0.5, 2.0),
+        augment_copies: int = 1,
+        augment_weight: float = 0.5,
+        branching: str = "filter",
+        branch_mix: float = 0.1,
+        select_k: str = "none",
+        k_candidates: tuple = (4, 8, 12, 16),
+        random_state: int = 0,
+    ):
+        self.n_components = n_components
+        self.reg_covar = reg_covar
+        self.max_iter = max_iter
+        self.tol = tol
+        self.augment = augment
+        self.augment_range = augment_range
+        self.augment_copies = augment_copies
+        self.augment_weight = augment_weight
+        self.branching = branching
+        self.branch_mix = branch_mix
+        self.select_k = select_k
+        self.k_candidates = k_candidates
+        self.random_state = random_state
+
+    # -- columns -------------------------------------------------------------------------
+    def _columns(self, samples):
+        """(input columns, output columns, rp columns, drp columns)."""
+        return list(RA_COLUMNS) + list(DRA_COLUMNS), list(VB_COLUMNS), [], []
+
+    def _validate(self):
+        n = self.name
+        check_int("n_components", self.n_components, 1, n)
+        check_float("reg_covar", self.reg_covar, 0.0, n, strict=True)
+        check_int("max_iter", self.max_iter, 1, n)
+        check_float("tol", self.tol, 0.0, n)
+        check_choice("augment", self.augment, ("dilation", "none"), n)
+        rng_ok = (
+            isinstance(self.augment_range, tuple | list)
+            and len(self.augment_range) == 2
+            and all(isinstance(v, int | float) for v in self.augment_range)
+            and 0 < self.augment_range[0] <= self.augment_range[1]
+        )
+        if not rng_ok:
+            raise ConfigError(
+                f"{n}: augment_range={self.augment_range!r}; expected (s_min, s_max) "
+                "with 0 < s_min <= s_max"
+            )
+        check_int("augment_copies", self.augment_copies, 0, n)
+        check_float("augment_weight", self.augment_weight, 0.0, n)
+        check_choice("branching", self.branching, ("filter", "none"), n)
+        check_float("branch_mix", self.branch_mix, 0.0, n)
+        if self.branch_mix > 1:
+            raise ConfigError(f"{n}: branch_mix={self.branch_mix!r}; expected a number in [0, 1]")
+        check_choice("select_k", self.select_k, ("none", "bic"), n)
+        if self.select_k == "bic":
+            if not self.k_candidates:
+                raise ConfigError(f"{n}: k_candidates is empty; give at least one K")
+            for k in self.k_candidates:
+                check_int("k_candidates", k, 1, n)
+        check_int("random_state", self.random_state, 0, n)
+
+    # -- fit -----------------------------------------------------------------------------
+    def fit(self, samples: pd.DataFrame, y=None):
+        self._validate()
+        cin, cout, rp_cols, drp_cols = self._columns(samples)
+        require_columns(samples, ("trial_id", "t", *cin, *cout), self.name)
+        Z = as_array(samples, cin + cout, self.name)
+        self.columns_in_, self.columns_out_ = cin, cout
+        self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
+        rate = np.array([c.startswith("d") or c in VB_COLUMNS for c in cin + cout])
+        rng = np.random.default_rng(self.random_state)
+        self.center_ = Z.mean(axis=0)
+        self.scale_ = np.where(Z.std(axis=0) > 0, Z.std(axis=0), 1.0)
+        data, weights = [Z], [np.ones(len(Z))]
+        if self.augment == "dilation" and self.augment_copies > 0 and self.augment_weight > 0:
+            lo, hi = np.log(self.augment_range[0]), np.log(self.augment_range[1])
+            for _ in range(self.augment_copies):
+                s = np.exp(rng.uniform(lo, hi, size=len(Z)))
+                copy = Z.copy()
+                copy[:, rate] *= s[:, None]
+                data.append(copy)
+                weights.append(np.full(len(Z), float(self.augment_weight)))
+        X = (np.vstack(data) - self.center_) / self.scale_
+        w = np.concatenate(weights)
+        ks = [self.n_components] if self.select_k == "none" else list(self.k_candidates)
+        best, best_bic = None, np.inf
+        for k in ks:
+            mix = fit_mixture(X, k, w, self.max_iter, self.tol, self.reg_covar, rng)
+            bic = -2 * mix.log_likelihood * w.sum() + mix.n_parameters() * np.log(w.sum())
+            if bic < best_bic:
+                best, best_bic = mix, bic
+        self.priors_, self.means_, self.covariances_ = best.priors, best.means, best.covariances
+        self.n_iter_, self.converged_ = best.n_iter, best.converged
+        self.n_components_ = len(best.priors)
+        self.bic_ = best_bic
+        d = len(cin)
+        self._cond = Conditional.of(
+            self.priors_, self.means_, self.covariances_, np.arange(d), np.arange(d, len(rate))
+        )
+        # Branch transitions from consecutive original samples of the same trial.
+        K = self.n_components_
+        ts = TimeSeries.of(samples)
+        g = responsibilities(X[: len(Z)][ts.order], best)
+        pairs = ~ts.first[1:]
+        counts = g[:-1][pairs].T @ g[1:][pairs] if pairs.any() else np.zeros((K, K))
+        rows = counts.sum(axis=1, keepdims=True)
+        T = np.where(rows > 0, counts / np.where(rows > 0, rows, 1.0), self.priors_[None])
+        self.transition_ = (1 - self.branch_mix) * T + self.branch_mix * self.priors_[None]
+        self.n_features_in_ = d
+        return self
+
+    # -- predict -------------------------------------------------------------------------
+    def _gates(self, Xs, ts):
+        """Branch/gate weights (n, K) for standardised inputs in sorted order."""
+        lg = self._cond.log_gate(Xs)
+        if self.branching == "filter":
+            return forward_filter(
+                lg - np.log(self.priors_), self.transition_, self.priors_, ts.first
+            )
+        h = np.exp(lg - lg.max(axis=1, keepdims=True))
+        return h / h.sum(axis=1, keepdims=True)
+
+    def _predict_measured(self, samples):
+        d = len(self.columns_in_)
+        Xin = as_array(samples, self.columns_in_, self.name)
+        ts = TimeSeries.of(samples)
+        Xs = ((Xin - self.center_[:d]) / self.scale_[:d])[ts.order]
+        h = self._gates(Xs, ts)
+        ys = np.einsum("nk,nkq->nq", h, self._cond.local_means(Xs))
+        return ts.unsort(ys * self.scale_[d:] + self.center_[d:])
+
+    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
+        self._check_fitted()
+        require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
+        return self._output_frame(self._predict_measured(samples), samples)
+
+
+class GMRSuds(GMR):
+    """A-GBR of (v_b, dr_p/dt) on (r_a, r_p, dr_a/dt). Parameters of `GMR` plus
+
+    mode : {"measured", "rollout"}, default "measured"
+        "measured" uses the test trial's r_p; "rollout" integrates r_p from each
+        trial's first sample with the learned dr_p/dt.
+    """
+
+    name = "GMR+SUDS"
+    suds = True
+
+    def __init__(
+        self,
+        n_components: int = 12,
+        reg_covar: float = 1e-3,
+        max_iter: int = 60,
+        tol: float = 1e-3,
+        augment: str = "dilation",
+        augment_range: tuple = (0.5, 2.0),
+        augment_copies: int = 1,
+        augment_weight: float = 0.5,
+        branching: str = "filter",
+        branch_mix: float = 0.1,
+        select_k: str = "none",
+        k_candidates: tuple = (4, 8, 12, 16),
+        random_state: int = 0,
+        mode: str = "measured",
+    ):
+        super().__init__(
+            n_components,
+            reg_covar,
+            max_iter,
+            tol,
+            augment,
+            augment_range,
+            augment_copies,
+            augment_weight,
+            branching,
+            branch_mix,
+            select_k,
+            k_candidates,
+            random_state,
+        )
+        self.mode = mode
+
+    def _validate(self):
+        super()._validate()
+        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+
+    def _columns(self, samples):
+        rp, drp = passive_columns(samples)
+        if not rp:
+            raise ModelError(f"{self.name}: samples frame has no rp_1.. columns (passive shape)")
+        return list(RA_COLUMNS) + rp + list(DRA_COLUMNS), list(VB_COLUMNS) + drp, rp, drp
+
+    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+        self._check_fitted()
+        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
+        if self.mode == "measured":
+            return self._output_frame(self._predict_measured(samples), samples)
+        return self._output_frame(self._predict_rollout(samples), samples)
+
+    def _predict_rollout(self, samples):
+        d = len(self.columns_in_)
+        k = len(self.rp_columns_)
+        Xin = as_array(samples, self.columns_in_, self.name)
+        ts = TimeSeries.of(samples)
+        Xs = ((Xin - self.center_[:d]) / self.scale_[:d])[ts.order]
+        # r_p occupies inputs 2..2+k and outputs 3..3+k; in standardised units one Euler
+        # step is rp_s += dt * drp_s * scale_out / scale_in.
+        gain = self.scale_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
+        off = self.center_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
+        span = (self.means_[:, 2 : 2 + k].max(0) - self.means_[:, 2 : 2 + k].min(0)) + 1e-9
+        lo = self.means_[:, 2 : 2 + k].min(0) - 0.5 * span - 2.0
+        hi = self.means_[:, 2 : 2 + k].max(0) + 0.5 * span + 2.0
+        c = self._cond
+        P, mu_in, reg, mu_out = c.prec_in, c.mean_in, c.reg, c.mean_out
+        filt = self.branching == "filter"
+        T, pri = self.transition_, self.priors_
+        first = ts.first
+        out = np.empty((len(Xs), mu_out.shape[1]))
+        a = pri
+        x = Xs[0].copy()
+        for t in range(len(Xs)):
+            if first[t]:
+                x = Xs[t].copy()
+            else:
+                x[:2] = Xs[t, :2]
+                x[2 + k :] = Xs[t, 2 + k :]
+                x[2 : 2 + k] = np.clip(
+                    x[2 : 2 + k] + ts.dt[t] * (gain * out[t - 1, 3 : 3 + k] + off), lo, hi
+                )
+            diff = x - mu_in
+            yk = np.einsum("kd,kde->ke", diff, P)
+            lg = c.log_norm - 0.5 * (yk * yk).sum(1)
+            e = np.exp(lg - lg.max())
+            if filt:
+                e = e / pri
+                a = e * (pri if first[t] else a @ T)
+            else:
+                a = e
+            s = a.sum()
+            a = a / s if s > 0 else pri
+            ys = a @ (mu_out + np.einsum("kqd,kd->kq", reg, diff))
+            out[t] = ys
+        return ts.unsort(out * self.scale_[d:] + self.center_[d:])

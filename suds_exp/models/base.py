@@ -1,0 +1,169 @@
+"""What every learner shares: reading a samples frame, trials as time series, checks.
+
+A samples frame has the columns of the `samples` table (see DESIGN.md): `trial_id`,
+`t` (s), `phase` (rad, unwrapped), `ra_1`, `ra_2` (rad), `dra_1`, `dra_2` (rad/s),
+`rp_1..rp_k`, `drp_1..drp_k`, `vx`, `vy` (mm/s), `wz` (rad/s), all in the body frame.
+Learners never assume the rows are sorted: every time-series operation works on the
+rows ordered by (`trial_id`, `t`) and results are put back in the caller's order.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from sklearn.base import BaseEstimator
+
+from suds_exp.errors import ConfigError, SudsError
+
+VB_COLUMNS = ("vx", "vy", "wz")
+RA_COLUMNS = ("ra_1", "ra_2")
+DRA_COLUMNS = ("dra_1", "dra_2")
+_RP_PATTERN = re.compile(r"^rp_(\d+)$")
+
+
+class ModelError(SudsError):
+    """A samples frame cannot be used by a learner as given (missing column, too few rows)."""
+
+
+def passive_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
+    """Names of the passive shape columns present, in order.
+
+    Returns `(["rp_1", ..., "rp_k"], ["drp_1", ..., "drp_k"])`; k is the number of
+    consecutive `rp_i` columns starting at 1 (0 when there are none).
+    """
+    present = {int(m.group(1)) for c in samples.columns if (m := _RP_PATTERN.match(str(c)))}
+    k = 0
+    while k + 1 in present:
+        k += 1
+    return [f"rp_{i}" for i in range(1, k + 1)], [f"drp_{i}" for i in range(1, k + 1)]
+
+
+def require_columns(samples: pd.DataFrame, columns, model: str) -> None:
+    """Raise ModelError naming the first missing column."""
+    if not isinstance(samples, pd.DataFrame):
+        raise ModelError(f"{model}: expected a pandas DataFrame of samples, got {type(samples)}")
+    missing = [c for c in columns if c not in samples.columns]
+    if missing:
+        raise ModelError(
+            f"{model}: samples frame lacks column(s) {', '.join(missing)}; "
+            "expected the columns of the `samples` table"
+        )
+    if len(samples) == 0:
+        raise ModelError(f"{model}: samples frame is empty")
+
+
+def as_array(samples: pd.DataFrame, columns, model: str) -> np.ndarray:
+    """Columns as a float array of shape (n_samples, len(columns)); NaN/inf is an error."""
+    x = samples.loc[:, list(columns)].to_numpy(dtype=float)
+    if not np.isfinite(x).all():
+        bad = [c for c, ok in zip(columns, np.isfinite(x).all(axis=0), strict=True) if not ok]
+        raise ModelError(f"{model}: column(s) {', '.join(bad)} hold NaN or inf values")
+    return x
+
+
+@dataclass(frozen=True)
+class TimeSeries:
+    """Row order that makes every trial a contiguous, time-ordered run.
+
+    `order` (n,) indexes the caller's rows in (trial_id, t) order; `starts` (n_trials + 1,)
+    are the run boundaries in that order; `dt` (n,) is the step to the previous sample of
+    the same trial in s (0 at each trial's first sample).
+    """
+
+    order: np.ndarray
+    starts: np.ndarray
+    dt: np.ndarray
+
+    @classmethod
+    def of(cls, samples: pd.DataFrame) -> TimeSeries:
+        trial = samples["trial_id"].to_numpy() if "trial_id" in samples else np.zeros(len(samples))
+        t = samples["t"].to_numpy(dtype=float)
+        order = np.lexsort((t, trial))
+        ts, tr = t[order], trial[order]
+        new = np.ones(len(order), dtype=bool)
+        new[1:] = tr[1:] != tr[:-1]
+        starts = np.append(np.flatnonzero(new), len(order))
+        dt = np.diff(ts, prepend=ts[0])
+        dt[new] = 0.0
+        return cls(order=order, starts=starts, dt=dt)
+
+    @property
+    def first(self) -> np.ndarray:
+        """Boolean mask (in sorted order) of each trial's first sample."""
+        m = np.zeros(len(self.order), dtype=bool)
+        m[self.starts[:-1]] = True
+        return m
+
+    def unsort(self, values: np.ndarray) -> np.ndarray:
+        """Put rows computed in sorted order back into the caller's order."""
+        out = np.empty_like(values)
+        out[self.order] = values
+        return out
+
+
+def phase_rate(samples: pd.DataFrame) -> np.ndarray:
+    """d(phase)/dt per sample, rad/s, shape (n_samples,), estimated within each trial.
+
+    Central differences of the unwrapped `phase` column against `t` (one-sided at the
+    ends of a trial); a trial of a single sample gets the median rate of the others.
+    """
+    ts = TimeSeries.of(samples)
+    ph = samples["phase"].to_numpy(dtype=float)[ts.order]
+    t = samples["t"].to_numpy(dtype=float)[ts.order]
+    rate = np.full(len(ph), np.nan)
+    for a, b in zip(ts.starts[:-1], ts.starts[1:], strict=True):
+        if b - a >= 2:
+            rate[a:b] = np.gradient(ph[a:b], t[a:b])
+    if np.isnan(rate).all():
+        raise ModelError(
+            "samples frame: every trial has a single sample; cannot estimate phase rate"
+        )
+    rate[np.isnan(rate)] = np.nanmedian(rate)
+    return ts.unsort(rate)
+
+
+def check_int(name: str, value, low: int, model: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise ConfigError(f"{model}: {name}={value!r}; expected an integer >= {low}")
+    return int(value)
+
+
+def check_float(name: str, value, low: float, model: str, strict: bool = False) -> float:
+    ok = isinstance(value, int | float | np.floating | np.integer) and not isinstance(value, bool)
+    if ok:
+        ok = value > low if strict else value >= low
+    if not ok:
+        raise ConfigError(
+            f"{model}: {name}={value!r}; expected a number {'>' if strict else '>='} {low}"
+        )
+    return float(value)
+
+
+def check_choice(name: str, value, choices, model: str):
+    if value not in choices:
+        raise ConfigError(
+            f"{model}: {name}={value!r}; expected one of {', '.join(map(str, choices))}"
+        )
+    return value
+
+
+class Learner(BaseEstimator):
+    """Common face of the learners: `fit(samples) -> self`, `predict(samples) -> DataFrame`.
+
+    Subclasses set `name` (the learner name of `make_model`) and `suds` (whether the
+    learner models r_p and predicts dr_p/dt).
+    """
+
+    name = "learner"
+    suds = False
+
+    def _output_frame(self, values: np.ndarray, samples: pd.DataFrame) -> pd.DataFrame:
+        cols = list(VB_COLUMNS) + (list(self.drp_columns_) if self.suds else [])
+        return pd.DataFrame(values, index=samples.index, columns=cols)
+
+    def _check_fitted(self):
+        if not hasattr(self, "n_features_in_"):
+            raise ModelError(f"{self.name}: predict called before fit")

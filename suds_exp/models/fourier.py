@@ -1,0 +1,44 @@
+"""Real Fourier series in phase: basis, its phase derivative, least-squares fit."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def basis(phase: np.ndarray, order: int) -> np.ndarray:
+    """Fourier basis [1, cos p, sin p, ..., cos(m p), sin(m p)].
+
+    phase: array of shape (n,), rad. Returns an array of shape (n, 2 * order + 1).
+    """
+    phase = np.asarray(phase, dtype=float)
+    m = np.arange(1, order + 1)
+    arg = phase[:, None] * m[None, :]
+    out = np.empty((len(phase), 2 * order + 1))
+    out[:, 0] = 1.0
+    out[:, 1::2] = np.cos(arg)
+    out[:, 2::2] = np.sin(arg)
+    return out
+
+
+def basis_derivative(phase: np.ndarray, order: int) -> np.ndarray:
+    """d/d(phase) of `basis(phase, order)`, shape (n, 2 * order + 1), per rad."""
+    phase = np.asarray(phase, dtype=float)
+    m = np.arange(1, order + 1)
+    arg = phase[:, None] * m[None, :]
+    out = np.zeros((len(phase), 2 * order + 1))
+    out[:, 1::2] = -m * np.sin(arg)
+    out[:, 2::2] = m * np.cos(arg)
+    return out
+
+
+def fit(phase: np.ndarray, values: np.ndarray, order: int, ridge: float = 1e-9) -> np.ndarray:
+    """Least-squares Fourier coefficients of `values` over `phase`.
+
+    phase: (n,) rad; values: (n, q). Returns W of shape (2 * order + 1, q) with
+    values ~ basis(phase, order) @ W. `ridge` (relative to the mean diagonal of the
+    normal matrix) keeps the solve defined when the phases do not cover the circle.
+    """
+    F = basis(phase, order)
+    G = F.T @ F
+    G[np.diag_indices_from(G)] += ridge * np.trace(G) / len(G)
+    return np.linalg.solve(G, F.T @ np.asarray(values, dtype=float).reshape(len(F), -1))

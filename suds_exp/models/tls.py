@@ -1,0 +1,371 @@
+"""Phase-based total least squares: TLS (Bittner, Hatton, Revzen 2018) and TLS+SUDS.
+
+Model (per phase bin k, Bittner et al. 2018 eq. for v_b)::
+
+    v_b ~ C^k + B^k delta + A^k delta_dot_a + dA^k (delta x delta_dot_a)
+
+- r_bar(phase): mean gait, Fourier series of order `gait_order` fitted to r by least
+  squares; delta = r - r_bar(phase); delta_dot_a = dr_a/dt - r_bar_a'(phase) dphase/dt,
+  with dphase/dt estimated from the unwrapped phase column within each trial.
+- TLS uses r = r_a. TLS+SUDS (Bittner et al. 2022) uses r = (r_a, r_p) and fits the
+  passive dynamics dr_p/dt = C(r) dr_a/dt + D(r) alongside, linearised the same way
+  (same regressors, outputs (v_b, dr_p/dt) in one total least squares per bin). Only
+  dr_a/dt enters the right-hand side: SUDS makes dr_p/dt unnecessary there.
+- Each bin is a window of the phase circle (`n_bins` centres, window `bin_width` bins
+  wide); a bin holding fewer than `min_bin_factor` x (regressors + outputs) samples
+  takes that many phase-nearest samples instead, so few-cycle training stays defined.
+- Total least squares (errors in variables): centre [X y] on the bin means, scale each
+  column by its standard deviation, take the SVD solution per output; regressor
+  directions with no more spread than the noise are truncated (`tls_gap`, see
+  `tls_solve`), which keeps TLS from exploding on near-collinear regressors.
+- The bin coefficients (C, B, A, dA) are interpolated over phase by a Fourier series of
+  order `coef_order` fitted to the bin centres.
+
+Rollout (TLS+SUDS, mode="rollout"): at fixed phase and r_a the fitted dr_p/dt is affine
+in r_p, dr_p/dt = a_t + M_t r_p, so r_p is integrated from each trial's first measured
+value by the trapezoidal rule (A-stable, second order): the test trial's r_p is used only
+at its first sample.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.errors import ConfigError
+from suds_exp.models import fourier
+from suds_exp.models.base import (
+    DRA_COLUMNS,
+    RA_COLUMNS,
+    VB_COLUMNS,
+    Learner,
+    ModelError,
+    TimeSeries,
+    as_array,
+    check_choice,
+    check_float,
+    check_int,
+    passive_columns,
+    phase_rate,
+    require_columns,
+)
+
+_TWO_PI = 2.0 * np.pi
+
+
+def tls_solve(X: np.ndarray, Y: np.ndarray, gap: float = 2.0):
+    """Total least squares Y ~ c + X B from the SVD of the centred, column-scaled data.
+
+    X: (n, p); Y: (n, q); each output is solved on its own after dividing every column
+    of X and y by its standard deviation. With Xs = U S V^T (principal components of the
+    regressors) and sigma the smallest singular value of [Xs ys], the TLS solution is
+    b = V (S^2 - sigma^2 I)^-1 S U^T ys, the closed form of the SVD solution of [Xs ys].
+    TLS is undefined (and explodes) when a regressor direction carries no more spread
+    than the noise, as with r_p following r_a almost exactly; such directions
+    (S_i^2 <= gap * sigma^2, recomputing sigma on the directions kept) are truncated,
+    which bounds the TLS de-attenuation of any kept direction by 1 / (1 - 1 / gap).
+    Columns with zero spread get coefficient 0.
+
+    Returns (c of shape (q,), B of shape (p, q), number of regressor directions kept,
+    summed over outputs).
+    """
+    n, p = X.shape
+    q = Y.shape[1]
+    xm, ym = X.mean(axis=0), Y.mean(axis=0)
+    Xc, Yc = X - xm, Y - ym
+    sx, sy = Xc.std(axis=0), Yc.std(axis=0)
+    live = sx > 1e-12 * max(1.0, float(np.abs(X).max(initial=0.0)))
+    sy = np.where(sy > 0, sy, 1.0)
+    B = np.zeros((p, q))
+    n_kept = 0
+    if not live.any():
+        return ym, B, n_kept
+    Xs = Xc[:, live] / sx[live]
+    U, S, Vt = np.linalg.svd(Xs, full_matrices=False)
+    Ys = Yc / sy
+    proj = U.T @ Ys  # (r, q): each output in principal-component coordinates
+    resid2 = np.maximum((Ys * Ys).sum(axis=0) - (proj * proj).sum(axis=0), 0.0)
+    for j in range(q):
+        keep = S > 1e-12 * S[0]
+        for _ in range(4):
+            # smallest singular value of [U_k S_k, ys]: the smallest root of the secular
+            # equation, found from the small (k+1) x (k+1) Gram matrix.
+            k = int(keep.sum())
+            if k == 0:
+                break
+            G = np.empty((k + 1, k + 1))
+            G[:k, :k] = np.diag(S[keep] ** 2)
+            G[:k, k] = G[k, :k] = S[keep] * proj[keep, j]
+            G[k, k] = (proj[keep, j] ** 2).sum() + resid2[j] + (proj[~keep, j] ** 2).sum()
+            sig2 = max(float(np.linalg.eigvalsh(G)[0]), 0.0)
+            new = keep & (S**2 > gap * sig2)
+            if (new == keep).all():
+                break
+            keep = new
+        if keep.any():
+            bpc = S[keep] * proj[keep, j] / (S[keep] ** 2 - sig2)
+            B[live, j] = (Vt[keep].T @ bpc) / sx[live] * sy[j]
+            n_kept += int(keep.sum())
+    return ym - xm @ B, B, n_kept
+
+
+def _features(delta: np.ndarray, ddot: np.ndarray) -> np.ndarray:
+    """Regressors [delta, delta_dot_a, delta x delta_dot_a], shape (n, m + a + m*a)."""
+    prod = (delta[:, :, None] * ddot[:, None, :]).reshape(len(delta), -1)
+    return np.hstack([delta, ddot, prod])
+
+
+class TLS(Learner):
+    """Phase-binned total least squares motility map (see the module docstring).
+
+    Parameters
+    ----------
+    n_bins : int, default 16
+        Number of phase bins (centres evenly spaced on [0, 2 pi)).
+    bin_width : float, default 1.5
+        Width of each bin's phase window, in units of the bin spacing (1 = disjoint).
+    gait_order : int, default 5
+        Fourier order of the mean gait r_bar(phase).
+    coef_order : int, default 3
+        Fourier order used to interpolate the bin coefficients over phase;
+        2 * coef_order + 1 must not exceed n_bins.
+    min_bin_factor : float, default 2.0
+        A bin uses at least this many times (regressors + 2) samples.
+    tls_gap : float, default 2.0
+        Regressor directions whose squared singular value is not above tls_gap times the
+        TLS noise level are truncated (> 1; large values approach principal-component
+        regression, values near 1 plain TLS).
+
+    Attributes
+    ----------
+    gait_coef_ : array of shape (2 * gait_order + 1, n_r)
+        Mean gait r_bar(phase) Fourier coefficients (rad for r_a, r_p units for r_p).
+    coef_ : array of shape (2 * coef_order + 1, 1 + n_regressors, n_outputs)
+        Fourier coefficients over phase of [C; B; A; dA] per output.
+    bin_coef_ : array of shape (n_bins, 1 + n_regressors, n_outputs)
+        The raw per-bin TLS coefficients.
+    kept_fraction_ : float
+        Fraction of regressor directions kept by the TLS solves (see `tls_solve`), over
+        bins and outputs; well below 1 means nearly collinear regressors.
+    """
+
+    name = "TLS"
+
+    def __init__(
+        self,
+        n_bins: int = 16,
+        bin_width: float = 1.5,
+        gait_order: int = 5,
+        coef_order: int = 3,
+        min_bin_factor: float = 2.0,
+        tls_gap: float = 2.0,
+    ):
+        self.n_bins = n_bins
+        self.bin_width = bin_width
+        self.gait_order = gait_order
+        self.coef_order = coef_order
+        self.min_bin_factor = min_bin_factor
+        self.tls_gap = tls_gap
+
+    # -- columns -------------------------------------------------------------------
+    def _shape_columns(self, samples):
+        return list(RA_COLUMNS), []
+
+    def _output_columns(self):
+        return list(VB_COLUMNS)
+
+    def _validate(self):
+        nb = check_int("n_bins", self.n_bins, 1, self.name)
+        check_float("bin_width", self.bin_width, 0.0, self.name, strict=True)
+        check_int("gait_order", self.gait_order, 0, self.name)
+        co = check_int("coef_order", self.coef_order, 0, self.name)
+        check_float("min_bin_factor", self.min_bin_factor, 1.0, self.name)
+        check_float("tls_gap", self.tls_gap, 1.0, self.name, strict=True)
+        if 2 * co + 1 > nb:
+            raise ConfigError(
+                f"{self.name}: coef_order={co} needs n_bins >= {2 * co + 1}, got n_bins={nb}"
+            )
+
+    # -- shared pieces -----------------------------------------------------------------
+    def _offsets(self, samples, r, dra):
+        """delta (n, n_r) and delta_dot_a (n, 2) from the mean gait."""
+        phase = samples["phase"].to_numpy(dtype=float)
+        rbar = fourier.basis(phase, self.gait_order) @ self.gait_coef_
+        drbar_a = fourier.basis_derivative(phase, self.gait_order) @ self.gait_coef_[:, :2]
+        return r - rbar, dra - drbar_a * phase_rate(samples)[:, None]
+
+    def _coef_at(self, phase):
+        """Coefficients at each sample's phase, shape (n, 1 + n_regressors, n_outputs)."""
+        F = fourier.basis(phase, self.coef_order)
+        return np.einsum("nf,fpq->npq", F, self.coef_)
+
+    def coefficients(self, phase) -> dict[str, np.ndarray]:
+        """The fitted model's terms at the given phases (rad, array of shape (n,)).
+
+        Returns a dict of arrays: `C` (n, q); `B` (n, q, n_r) with B[:, i, j] = d out_i /
+        d delta_j; `A` (n, q, 2) with A[:, i, j] = d out_i / d delta_dot_a_j (the
+        connection, e.g. mm/rad for vx); `dA` (n, q, 2, n_r) with dA[:, i, j, l] =
+        d A[i, j] / d r_l; `r_bar` (n, n_r). q runs over vx, vy, wz (then dr_p/dt).
+        """
+        self._check_fitted()
+        phase = np.asarray(phase, dtype=float).ravel()
+        th = self._coef_at(phase)
+        m = self.gait_coef_.shape[1]
+        C = th[:, 0, :]
+        B = th[:, 1 : 1 + m, :].transpose(0, 2, 1)
+        A = th[:, 1 + m : 3 + m, :].transpose(0, 2, 1)
+        dA = th[:, 3 + m :, :].reshape(len(phase), m, 2, -1).transpose(0, 3, 2, 1)
+        rbar = fourier.basis(phase, self.gait_order) @ self.gait_coef_
+        return {"C": C, "B": B, "A": A, "dA": dA, "r_bar": rbar}
+
+    def fit(self, samples: pd.DataFrame, y=None):
+        self._validate()
+        rp_cols, drp_cols = self._shape_columns(samples)
+        out_cols = self._output_columns() + drp_cols
+        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *rp_cols, *out_cols)
+        require_columns(samples, need, self.name)
+        r = as_array(samples, list(RA_COLUMNS) + rp_cols, self.name)
+        dra = as_array(samples, DRA_COLUMNS, self.name)
+        Y = as_array(samples, out_cols, self.name)
+        phase = samples["phase"].to_numpy(dtype=float)
+        self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
+
+        self.gait_coef_ = fourier.fit(phase, r, self.gait_order)
+        delta, ddot = self._offsets(samples, r, dra)
+        X = _features(delta, ddot)
+        n, p = X.shape
+        q = Y.shape[1]
+        need_n = int(np.ceil(self.min_bin_factor * (p + 2)))
+        if n < p + 3:
+            raise ModelError(
+                f"{self.name}: {n} training samples cannot fit {p} regressors and {q} outputs; "
+                f"give at least {p + 3} samples"
+            )
+        centres = np.arange(self.n_bins) * (_TWO_PI / self.n_bins)
+        half = 0.5 * self.bin_width * _TWO_PI / self.n_bins
+        wrapped = np.mod(phase, _TWO_PI)
+        bin_coef = np.empty((self.n_bins, p + 1, q))
+        n_kept = 0
+        for b, c in enumerate(centres):
+            off = np.angle(np.exp(1j * (wrapped - c)))
+            d = np.abs(off)
+            idx = np.flatnonzero(d <= half)
+            if len(idx) < need_n:
+                idx = np.argpartition(d, min(need_n, n) - 1)[: min(need_n, n)]
+            # The phase offset inside the window is a regressor too, so the drift of C
+            # across the window is not mistaken for noise; it is dropped afterwards
+            # (the bin's coefficients are those at the centre, offset 0). A single bin
+            # spans the whole circle, where an offset is meaningless.
+            if self.n_bins > 1:
+                c0, Bm, kept = tls_solve(np.column_stack([X[idx], off[idx]]), Y[idx], self.tls_gap)
+                Bm = Bm[:-1]
+            else:
+                c0, Bm, kept = tls_solve(X[idx], Y[idx], self.tls_gap)
+            bin_coef[b, 0], bin_coef[b, 1:] = c0, Bm
+            n_kept += kept
+        self.bin_coef_ = bin_coef
+        self.kept_fraction_ = n_kept / (self.n_bins * q * (p + (self.n_bins > 1)))
+        W = fourier.fit(centres, bin_coef.reshape(self.n_bins, -1), self.coef_order)
+        self.coef_ = W.reshape(-1, p + 1, q)
+        self.n_features_in_ = p
+        return self
+
+    def _predict_measured(self, samples, r, dra):
+        delta, ddot = self._offsets(samples, r, dra)
+        X1 = np.hstack([np.ones((len(r), 1)), _features(delta, ddot)])
+        th = self._coef_at(samples["phase"].to_numpy(dtype=float))
+        return np.einsum("np,npq->nq", X1, th)
+
+    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
+        self._check_fitted()
+        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *self.rp_columns_)
+        require_columns(samples, need, self.name)
+        r = as_array(samples, list(RA_COLUMNS) + self.rp_columns_, self.name)
+        dra = as_array(samples, DRA_COLUMNS, self.name)
+        return self._output_frame(self._predict_measured(samples, r, dra), samples)
+
+
+class TLSSuds(TLS):
+    """TLS with r = (r_a, r_p) and passive dynamics dr_p/dt = C(r) dr_a/dt + D(r).
+
+    Parameters are those of `TLS` plus
+
+    mode : {"measured", "rollout"}, default "measured"
+        "measured" uses the test trial's r_p at every sample; "rollout" integrates r_p
+        from each trial's first sample with the learned passive dynamics.
+
+    Requires at least one `rp_i` column; k = number of `rp_1..rp_k` columns present.
+    """
+
+    name = "TLS+SUDS"
+    suds = True
+
+    def __init__(
+        self,
+        n_bins: int = 16,
+        bin_width: float = 1.5,
+        gait_order: int = 5,
+        coef_order: int = 3,
+        min_bin_factor: float = 2.0,
+        tls_gap: float = 2.0,
+        mode: str = "measured",
+    ):
+        super().__init__(n_bins, bin_width, gait_order, coef_order, min_bin_factor, tls_gap)
+        self.mode = mode
+
+    def _validate(self):
+        super()._validate()
+        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+
+    def _shape_columns(self, samples):
+        rp, drp = passive_columns(samples)
+        if not rp:
+            raise ModelError(f"{self.name}: samples frame has no rp_1.. columns (passive shape)")
+        return rp, drp
+
+    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """Predicted vx, vy, wz and drp_1..drp_k; rollout mode integrates r_p per trial."""
+        self._check_fitted()
+        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        if self.mode == "measured":
+            return super().predict(samples)
+        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *self.rp_columns_)
+        require_columns(samples, need, self.name)
+        r = as_array(samples, list(RA_COLUMNS) + self.rp_columns_, self.name)
+        dra = as_array(samples, DRA_COLUMNS, self.name)
+        r = r.copy()
+        r[:, 2:] = self._rollout(samples, r, dra)
+        return self._output_frame(self._predict_measured(samples, r, dra), samples)
+
+    def _rollout(self, samples, r, dra):
+        """r_p integrated from each trial's first sample, shape (n, k), caller's order."""
+        k = len(self.rp_columns_)
+        n = len(r)
+        r0 = r.copy()
+        r0[:, 2:] = 0.0
+        base = self._predict_measured(samples, r0, dra)[:, 3:]  # dr_p/dt at r_p = 0
+        # Columns of M: response of dr_p/dt to a unit r_p_i, got by linearity in r_p.
+        M = np.empty((n, k, k))
+        for i in range(k):
+            ri = r0.copy()
+            ri[:, 2 + i] = 1.0
+            M[:, :, i] = self._predict_measured(samples, ri, dra)[:, 3:] - base
+        ts = TimeSeries.of(samples)
+        o = ts.order
+        a, M, dt = base[o], M[o], ts.dt
+        eye = np.eye(k)
+        h = 0.5 * dt[:, None, None]
+        lhs_inv = np.linalg.inv(eye - h * M)
+        M_prev = np.concatenate([M[:1], M[:-1]])
+        a_prev = np.concatenate([a[:1], a[:-1]])
+        P = lhs_inv @ (eye + h * M_prev)
+        c = np.einsum("nij,nj->ni", lhs_inv, h[:, :, 0] * (a + a_prev))
+        rp_meas = r[o, 2:]
+        out = np.empty((n, k))
+        first = ts.first
+        x = rp_meas[0]
+        for i in range(n):
+            x = rp_meas[i] if first[i] else P[i] @ x + c[i]
+            out[i] = x
+        return ts.unsort(out)
