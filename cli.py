@@ -81,7 +81,9 @@ def ingest(
     """
     from suds_exp.ingest import ingest_paths
 
-    results = ingest_paths(open_store(db), paths or [], manifest, layout, progress=not (quiet or json_))
+    results = ingest_paths(
+        open_store(db), paths or [], manifest, layout, progress=not (quiet or json_)
+    )
     if json_:
         console.print_json(
             [{"file": str(r.path), "status": r.status, "trial_id": r.trial_id} for r in results]

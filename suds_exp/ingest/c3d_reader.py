@@ -55,7 +55,11 @@ def read_c3d(path: Path, data: bytes) -> Capture:
             f"{path}: POINT:LABELS lists {len(names)} markers but frames hold {pts.shape[1]}"
         )
     xyz = pts[:, :, :3] * _TO_MM[unit]
-    invalid = (pts[:, :, 3] < 0) | np.all(pts[:, :, :3] == 0.0, axis=2) | ~np.all(np.isfinite(xyz), axis=2)
+    invalid = (
+        (pts[:, :, 3] < 0)
+        | np.all(pts[:, :, :3] == 0.0, axis=2)
+        | ~np.all(np.isfinite(xyz), axis=2)
+    )
     xyz[invalid] = np.nan
     frame = np.asarray(frames, dtype=np.int64)
     return Capture(

@@ -41,6 +41,8 @@ class Capture:
     t: np.ndarray
     xyz: np.ndarray
     meta: dict = field(default_factory=dict)
+    #: 1-based file line of the first frame, for error messages (None: not a text file)
+    first_line: int | None = None
 
     @property
     def n_frames(self) -> int:
@@ -63,9 +65,10 @@ class Capture:
             bad = np.flatnonzero(steps <= 0)
             if bad.size:
                 i = int(bad[0]) + 1
+                where = f"line {self.first_line + i}" if self.first_line else f"frame index {i}"
                 raise IngestError(
-                    f"{name}: {label} values must increase strictly; data row {i + 1} "
-                    f"({label} {values[i]:g}) does not follow {values[i - 1]:g}"
+                    f"{name}: {where}: {label} values must increase strictly; "
+                    f"{values[i]:g} does not follow {values[i - 1]:g}"
                 )
         if not np.isfinite(self.sample_rate_hz) or self.sample_rate_hz <= 0:
             raise IngestError(f"{name}: sample rate must be a positive number of Hz")
@@ -95,7 +98,9 @@ class Capture:
         )
 
 
-def parse_numeric_block(path: Path, cells: pd.DataFrame, first_line: int, columns: list[str]) -> np.ndarray:
+def parse_numeric_block(
+    path: Path, cells: pd.DataFrame, first_line: int, columns: list[str]
+) -> np.ndarray:
     """Convert a block of text cells to floats; empty cells become NaN.
 
     ``first_line`` is the 1-based file line of the block's first row, so an error can

@@ -27,11 +27,15 @@ _COORD = re.compile(r"^(.+)_([xyz])$")
 def read_marker_csv(path: Path, text: str) -> Capture:
     """Parse the text of a marker CSV into a `Capture` (positions in mm)."""
     try:
-        cells = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False, on_bad_lines="error")
+        cells = pd.read_csv(
+            io.StringIO(text), dtype=str, keep_default_na=False, on_bad_lines="error"
+        )
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         line = re.search(r"line (\d+)", str(exc))
         where = f"line {line.group(1)}: " if line else ""
-        raise IngestError(f"{path}: {where}not a marker CSV (expected frame,t,<name>_x,...)") from None
+        raise IngestError(
+            f"{path}: {where}not a marker CSV (expected frame,t,<name>_x,...)"
+        ) from None
     columns = [c.strip() for c in cells.columns]
     if columns[:2] != ["frame", "t"] or (len(columns) - 2) % 3 or len(columns) < 5:
         raise IngestError(
@@ -40,9 +44,11 @@ def read_marker_csv(path: Path, text: str) -> Capture:
     names = []
     for i in range(2, len(columns), 3):
         found = [_COORD.match(c) for c in columns[i : i + 3]]
-        if not all(found) or {m.group(1) for m in found} != {found[0].group(1)} or [
-            m.group(2) for m in found
-        ] != ["x", "y", "z"]:
+        if (
+            not all(found)
+            or {m.group(1) for m in found} != {found[0].group(1)}
+            or [m.group(2) for m in found] != ["x", "y", "z"]
+        ):
             raise IngestError(
                 f"{path}: line 1, column {i + 1}: expected <name>_x,<name>_y,<name>_z, "
                 f"got {','.join(columns[i : i + 3])}"
@@ -70,6 +76,7 @@ def read_marker_csv(path: Path, text: str) -> Capture:
         frame=frame.astype(np.int64),
         t=t,
         xyz=values[:, 2:].reshape(len(t), len(names), 3),
+        first_line=2,
     )
     capture.validate()
     if np.any(np.abs(steps - dt) > 0.01 * dt):

@@ -48,7 +48,9 @@ def read_layout(path: Path) -> dict[str, str]:
     for i, (role, marker) in enumerate(zip(table.role, table.marker, strict=True), start=2):
         role, marker = role.strip(), marker.strip()
         if role not in ROLES:
-            raise IngestError(f"{path}: line {i}: unknown role {role!r}; expected one of {', '.join(ROLES)}")
+            raise IngestError(
+                f"{path}: line {i}: unknown role {role!r}; expected one of {', '.join(ROLES)}"
+            )
         if role in layout:
             raise IngestError(f"{path}: line {i}: role {role!r} is given twice")
         layout[role] = marker
@@ -58,7 +60,9 @@ def read_layout(path: Path) -> dict[str, str]:
     return layout
 
 
-def check_layout(layout: dict[str, str], marker_names: list[str], source: str, capture: Path) -> None:
+def check_layout(
+    layout: dict[str, str], marker_names: list[str], source: str, capture: Path
+) -> None:
     """Raise unless every marker the layout names is in ``marker_names``."""
     have = set(marker_names)
     for role, marker in layout.items():

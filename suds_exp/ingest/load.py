@@ -72,7 +72,10 @@ def ingest_file(
         ).scalar_one_or_none()
         if existing is not None:
             return IngestResult(
-                path, "skipped", existing, capture.n_frames,
+                path,
+                "skipped",
+                existing,
+                capture.n_frames,
                 f"{path}: already ingested as trial {existing} (same content); nothing done",
             )
         if condition is not None:
@@ -105,11 +108,17 @@ def ingest_file(
         ).scalar_one()
         store.insert_df(conn, markers.name, capture.long_frame(trial_id))
     label = (
-        f"{condition.gait} {condition.frequency_hz:g} Hz #{condition.repeat}" if condition else "no condition"
+        f"{condition.gait} {condition.frequency_hz:g} Hz #{condition.repeat}"
+        if condition
+        else "no condition"
     )
     return IngestResult(
-        path, "ingested", trial_id, capture.n_frames,
-        f"{path}: trial {trial_id}, {capture.n_frames} frames, {len(capture.marker_names)} markers ({label})",
+        path,
+        "ingested",
+        trial_id,
+        capture.n_frames,
+        f"{path}: trial {trial_id}, {capture.n_frames} frames, "
+        f"{len(capture.marker_names)} markers ({label})",
     )
 
 
@@ -146,11 +155,16 @@ def ingest_paths(
     if not files:
         raise IngestError("nothing to ingest: give capture files, folders or --manifest")
     results = []
-    with progress_bar("Ingesting", total=len(files), enabled=progress and len(files) > 1) as advance:
+    with progress_bar(
+        "Ingesting", total=len(files), enabled=progress and len(files) > 1
+    ) as advance:
         for path in files:
             results.append(
                 ingest_file(
-                    store, path, conditions.get(Path(path).resolve()), roles,
+                    store,
+                    path,
+                    conditions.get(Path(path).resolve()),
+                    roles,
                     str(layout) if layout else "layout",
                 )
             )

@@ -105,13 +105,15 @@ def read_qtm_tsv(path: Path, text: str) -> Capture:
         line = re.search(r"line (\d+)", str(exc))
         where = f"line {table_at + 1 + int(line.group(1))}: " if line else ""
         raise IngestError(f"{path}: {where}expected {n_cols} tab-separated values") from None
-    # A trailing tab makes one extra, empty column; anything else there is extra data.
-    extra = cells[n_cols].fillna("").str.strip() if n_cols in cells else pd.Series(dtype=str)
-    short = cells[n_cols - 1].isna() if len(cells) else pd.Series(dtype=bool)
-    if (extra != "").any() or short.any():
-        row = int(np.flatnonzero((extra != "").to_numpy() | short.to_numpy())[0])
+    # A well-formed line has n_cols cells, plus an empty one after a trailing tab.
+    tabs = np.fromiter((line.count("\t") for line in body), dtype=np.int64, count=len(body))
+    extra = cells[n_cols].fillna("").str.strip() != "" if n_cols in cells else False
+    wrong = (tabs < n_cols - 1) | (tabs > n_cols) | np.asarray(extra)
+    if wrong.any():
+        row = int(np.flatnonzero(wrong)[0])
         raise IngestError(
-            f"{path}: line {table_at + 2 + row}: expected {n_cols} tab-separated values"
+            f"{path}: line {table_at + 2 + row}: expected {n_cols} tab-separated values, "
+            f"got {tabs[row] + 1 - (1 if body[row].endswith(chr(9)) else 0)}"
         )
     values = parse_numeric_block(path, cells.iloc[:, :n_cols], table_at + 2, expected)
     xyz = values[:, 2:].reshape(len(body), n_markers, 3)
@@ -121,7 +123,9 @@ def read_qtm_tsv(path: Path, text: str) -> Capture:
     frame = values[:, 0]
     if np.any(np.isnan(frame)) or np.any(frame != np.round(frame)):
         row = int(np.flatnonzero(np.isnan(frame) | (frame != np.round(frame)))[0])
-        raise IngestError(f"{path}: line {table_at + 2 + row}, column 'Frame': expected a whole number")
+        raise IngestError(
+            f"{path}: line {table_at + 2 + row}, column 'Frame': expected a whole number"
+        )
     return Capture(
         path=path,
         format="qtm-tsv",
@@ -131,4 +135,5 @@ def read_qtm_tsv(path: Path, text: str) -> Capture:
         t=values[:, 1],
         xyz=xyz,
         meta={"trajectory_types": header.get("TRAJECTORY_TYPES", [])},
+        first_line=table_at + 2,
     )

@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+import duckdb
 import sqlalchemy as sa
 
 from suds_exp.errors import StoreError
@@ -85,20 +86,29 @@ def pending(conn: sa.Connection, migrations: list[Migration]) -> list[Migration]
     return [m for m in migrations if m.version not in done]
 
 
-def upgrade(engine: sa.Engine, target: int | None = None, directory: Path = MIGRATIONS_DIR) -> list[str]:
+def upgrade(
+    engine: sa.Engine, target: int | None = None, directory: Path = MIGRATIONS_DIR
+) -> list[str]:
     """Apply pending migrations up to ``target`` (all when None); return their names."""
-    migrations = [m for m in available_migrations(directory) if target is None or m.version <= target]
+    migrations = [
+        m for m in available_migrations(directory) if target is None or m.version <= target
+    ]
     with engine.begin() as conn:
         todo = pending(conn, migrations)
     applied = []
     for m in todo:
         with engine.begin() as conn:
             # DuckDB executes a multi-statement script in the open transaction.
-            conn.connection.driver_connection.execute(m.sql)
+            try:
+                conn.connection.driver_connection.execute(m.sql)
+            except duckdb.Error as exc:
+                reason = str(exc).strip().splitlines()[0]
+                raise StoreError(
+                    f"migration {m.name}.sql failed and was not applied: {reason}"
+                ) from None
             conn.execute(
                 sa.text(
-                    "INSERT INTO schema_migrations (version, name, checksum) "
-                    "VALUES (:v, :n, :c)"
+                    "INSERT INTO schema_migrations (version, name, checksum) VALUES (:v, :n, :c)"
                 ),
                 {"v": m.version, "n": m.name, "c": m.checksum},
             )

@@ -97,7 +97,9 @@ class Store:
         return len(df)
 
     @staticmethod
-    def frame(conn: sa.Connection, query: Any, params: Sequence | Mapping | None = None) -> pd.DataFrame:
+    def frame(
+        conn: sa.Connection, query: Any, params: Sequence | Mapping | None = None
+    ) -> pd.DataFrame:
         """Run ``query`` on ``conn`` and return a DataFrame through DuckDB's Arrow path.
 
         ``query`` is a SQLAlchemy Core statement (its bound parameters are used) or SQL
