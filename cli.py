@@ -126,5 +126,89 @@ def sql(
         console.print_frame(frame)
 
 
+@command()
+def run(
+    name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
+    prep: Annotated[str | None, typer.Option(help="Preprocessing version of the samples.")] = None,
+    models: Annotated[
+        str | None, typer.Option(help="Learners, comma-separated (default: all five).")
+    ] = None,
+    boots: Annotated[
+        int | None, typer.Option(help="Draws per (train, test) pair (default 10).")
+    ] = None,
+    train_cycles: Annotated[
+        int | None, typer.Option(help="Training (and test) cycles of the main grid (default 30).")
+    ] = None,
+    sweep: Annotated[
+        str | None,
+        typer.Option(help="Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper."),
+    ] = None,
+    train_conditions: Annotated[
+        str | None, typer.Option(help="GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).")
+    ] = None,
+    test_conditions: Annotated[str | None, typer.Option(help="As --train-conditions.")] = None,
+    mode: Annotated[
+        str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
+    ] = None,
+    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
+    backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
+    scheduler: Annotated[
+        str | None, typer.Option(help="dask scheduler address, e.g. tcp://host:8786.")
+    ] = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Create or continue a bootstrap campaign; Ctrl-C stops after saving finished jobs.
+
+    An option left out of a continued campaign takes its stored value; a different value
+    is refused. Example: suds-exp run paper --prep default --sweep paper --jobs 2
+    """
+    from suds_exp.campaign import CampaignOptions, run_campaign
+
+    options = CampaignOptions.parse(
+        prep=prep,
+        models=models,
+        boots=boots,
+        train_cycles=train_cycles,
+        sweep=sweep,
+        train_conditions=train_conditions,
+        test_conditions=test_conditions,
+        mode=mode,
+    )
+    summary = run_campaign(
+        open_store(db),
+        name,
+        options,
+        jobs=jobs,
+        backend=backend,
+        scheduler=scheduler,
+        progress=not (quiet or json_),
+    )
+    if json_:
+        console.print_json(summary.to_dict())
+    else:
+        console.out.print(summary.message())
+    if summary.interrupted:
+        raise typer.Exit(130)
+
+
+@command()
+def status(
+    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Jobs done / total per learner, rate and time left of a campaign (also while it runs)."""
+    from suds_exp.campaign import campaign_status
+    from suds_exp.campaign.status import print_status
+
+    report = campaign_status(open_store(db), name)
+    if json_:
+        console.print_json(report)
+    else:
+        print_status(report)
+
+
 if __name__ == "__main__":
     app()

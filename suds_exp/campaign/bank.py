@@ -1,0 +1,217 @@
+"""The samples a campaign draws from, decimated once and packed for sharing with workers.
+
+`SampleBank.build` takes a samples frame (columns of the `samples` table plus `gait`
+and `frequency_hz`), keeps the trials of the campaign's conditions and:
+
+- decimates each trial to the same number of samples per cycle: the target is the
+  smallest samples-per-cycle among those trials (sample rate / gait frequency, e.g.
+  100 at 1 Hz and 100 Hz capture) and a trial keeps every k-th sample, k =
+  round(its samples per cycle / target), counted from its first sample. Plain
+  decimation, no filter, so every condition keeps the same measurement noise;
+- finds each trial's complete cycles: a `cycle` value whose samples span at least
+  2 pi minus 2.5 median phase steps of the raw trial (the partial first and last
+  cycles of a recording fall out), grouped in runs of consecutive cycle numbers.
+
+All numeric columns are packed in one float64 array of shape (n_rows, n_columns) in
+(trial, time) order, so a worker gets the whole bank as one memory map (loky) or one
+scattered object (dask) instead of a copy per job.
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.campaign.conditions import Condition, condition_sort_key, format_condition, round_hz
+from suds_exp.campaign.errors import CampaignError
+
+_BASE = ("trial_id", "frame", "t", "phase", "cycle", "ra_1", "ra_2", "dra_1", "dra_2")
+_VB = ("vx", "vy", "wz")
+_RP = re.compile(r"^d?rp_\d+$")
+_TWO_PI = 2.0 * np.pi
+#: A cycle is complete when its samples span 2 pi less at most this many phase steps.
+COMPLETE_SLACK_STEPS = 2.5
+
+
+def sample_columns(samples: pd.DataFrame) -> list[str]:
+    """The standard numeric sample columns present in ``samples``, in contract order."""
+    missing = [c for c in (*_BASE, *_VB) if c not in samples.columns]
+    if missing:
+        raise CampaignError(
+            f"samples frame lacks column(s) {', '.join(missing)}; expected the columns of "
+            "the `samples` table (see DESIGN.md)"
+        )
+    rp = sorted((c for c in samples.columns if _RP.match(str(c))), key=lambda c: (c[0] == "d", c))
+    return [*_BASE, *rp, *_VB]
+
+
+@dataclass(frozen=True)
+class SampleBank:
+    """Decimated samples of a campaign's trials, as arrays a worker can share.
+
+    Attributes
+    ----------
+    values : array of shape (n_rows, len(columns)), float64
+        Every numeric sample column, rows in (trial, t) order; units as in `samples`.
+    columns : tuple of str
+        Column names of ``values``.
+    trial_ids : array of shape (n_trials,), int
+    row_start, row_stop : arrays of shape (n_trials,), int
+        Rows of each trial in ``values``.
+    trial_condition : tuple of Condition
+        (gait, frequency_hz) of each trial.
+    runs : tuple of tuple of (first_cycle, last_cycle)
+        Complete consecutive cycles of each trial.
+    samples_per_cycle : int
+        Target samples per cycle after decimation.
+    decimation : dict of frequency_hz -> int
+        Decimation factor used at each frequency.
+    """
+
+    values: np.ndarray
+    columns: tuple[str, ...]
+    trial_ids: np.ndarray
+    row_start: np.ndarray
+    row_stop: np.ndarray
+    trial_condition: tuple[Condition, ...]
+    runs: tuple[tuple[tuple[int, int], ...], ...]
+    samples_per_cycle: int
+    decimation: dict[float, int] = field(default_factory=dict)
+
+    # -- construction --------------------------------------------------------------
+    @classmethod
+    def build(cls, samples: pd.DataFrame, conditions: list[Condition] | None = None) -> SampleBank:
+        """Decimate and pack the trials of ``conditions`` (all conditions when None)."""
+        if "gait" not in samples.columns or "frequency_hz" not in samples.columns:
+            raise CampaignError(
+                "samples frame lacks `gait`/`frequency_hz`; load it with load_samples"
+            )
+        columns = sample_columns(samples)
+        frame = samples.loc[samples["gait"].notna() & samples["frequency_hz"].notna()]
+        hz = frame["frequency_hz"].astype(float).round(6)
+        if conditions is not None:
+            wanted = pd.MultiIndex.from_tuples(conditions)
+            keep = pd.MultiIndex.from_arrays([frame["gait"], hz]).isin(wanted)
+            frame, hz = frame.loc[keep], hz.loc[keep]
+        if frame.empty:
+            raise CampaignError("no samples with a (gait, frequency) condition to run on")
+        frame = frame.assign(_hz=hz.to_numpy()).sort_values(["trial_id", "t"], kind="stable")
+        groups = [(tid, g) for tid, g in frame.groupby("trial_id", sort=True)]
+
+        raw_spc = []
+        for tid, g in groups:
+            conds = g[["gait", "_hz"]].drop_duplicates()
+            if len(conds) != 1:
+                raise CampaignError(f"samples of trial {tid} have more than one condition")
+            dt = np.median(np.diff(g["t"].to_numpy(dtype=float))) if len(g) > 1 else np.nan
+            if not np.isfinite(dt) or dt <= 0:
+                raise CampaignError(f"trial {tid}: cannot tell its sample rate from column t")
+            raw_spc.append(1.0 / (dt * float(conds["_hz"].iloc[0])))
+        target = int(round(min(raw_spc)))
+
+        blocks, starts, stops, tids, conds_out, runs_out = [], [], [], [], [], []
+        decimation: dict[float, int] = {}
+        row = 0
+        for (tid, g), spc in zip(groups, raw_spc, strict=True):
+            cond = (str(g["gait"].iloc[0]), float(g["_hz"].iloc[0]))
+            k = max(1, int(round(spc / target)))
+            decimation.setdefault(cond[1], k)
+            runs = _complete_runs(g["phase"].to_numpy(float), g["cycle"].to_numpy())
+            block = g[columns].to_numpy(dtype=np.float64)[::k]
+            blocks.append(block)
+            tids.append(int(tid))
+            starts.append(row)
+            row += len(block)
+            stops.append(row)
+            conds_out.append(cond)
+            runs_out.append(runs)
+        return cls(
+            values=np.ascontiguousarray(np.concatenate(blocks)),
+            columns=tuple(columns),
+            trial_ids=np.asarray(tids, dtype=np.int64),
+            row_start=np.asarray(starts, dtype=np.int64),
+            row_stop=np.asarray(stops, dtype=np.int64),
+            trial_condition=tuple(conds_out),
+            runs=tuple(runs_out),
+            samples_per_cycle=target,
+            decimation=dict(sorted(decimation.items())),
+        )
+
+    def memmapped(self, folder: str | Path | None = None) -> SampleBank:
+        """The same bank with ``values`` in a read-only memory-mapped .npy file.
+
+        joblib's loky backend pickles a file-backed memory map as its file name, so every
+        worker maps the same pages instead of receiving a copy per task.
+        """
+        folder = Path(folder or tempfile.mkdtemp(prefix="suds_bank_"))
+        path = folder / "bank_values.npy"
+        np.save(path, self.values)
+        return replace(self, values=np.load(path, mmap_mode="r"))
+
+    # -- look-ups --------------------------------------------------------------------
+    @property
+    def conditions(self) -> list[Condition]:
+        return sorted(set(self.trial_condition), key=condition_sort_key)
+
+    def trials_of(self, cond: Condition) -> list[int]:
+        """Indices (into ``trial_ids``) of the trials of ``cond`` that have complete cycles."""
+        return [i for i, c in enumerate(self.trial_condition) if c == cond and self.runs[i]]
+
+    def n_cycles(self, i: int) -> int:
+        """Complete cycles of trial index ``i``."""
+        return sum(b - a + 1 for a, b in self.runs[i])
+
+    def rows(self, i: int, first: int, last: int) -> np.ndarray:
+        """``values`` rows of trial index ``i`` whose cycle is in [first, last]."""
+        block = self.values[self.row_start[i] : self.row_stop[i]]
+        cycle = block[:, self.columns.index("cycle")]
+        return block[(cycle >= first) & (cycle <= last)]
+
+    def frame(self, pieces: list[np.ndarray]) -> pd.DataFrame:
+        """A samples frame (float columns; trial_id, frame, cycle as int) of row blocks."""
+        data = np.concatenate(pieces) if len(pieces) > 1 else np.array(pieces[0])
+        out = pd.DataFrame(data, columns=list(self.columns))
+        for c in ("trial_id", "frame", "cycle"):
+            out[c] = out[c].astype(np.int64)
+        return out
+
+    def describe(self) -> dict[str, list[int]]:
+        """Condition -> ids of the trials used, for the campaign definition."""
+        out: dict[str, list[int]] = {}
+        for cond in self.conditions:
+            out[format_condition(cond)] = [int(self.trial_ids[i]) for i in self.trials_of(cond)]
+        return out
+
+
+def _complete_runs(phase: np.ndarray, cycle: np.ndarray) -> tuple[tuple[int, int], ...]:
+    """Runs (first, last) of consecutive complete cycles of one trial's raw samples."""
+    if len(phase) < 3:
+        return ()
+    step = float(np.median(np.abs(np.diff(phase))))
+    cycle = cycle.astype(np.int64)
+    ids, inverse = np.unique(cycle, return_inverse=True)
+    lo = np.full(len(ids), np.inf)
+    hi = np.full(len(ids), -np.inf)
+    np.minimum.at(lo, inverse, phase)
+    np.maximum.at(hi, inverse, phase)
+    complete = ids[(hi - lo) >= _TWO_PI - COMPLETE_SLACK_STEPS * step]
+    runs: list[tuple[int, int]] = []
+    for c in complete.tolist():
+        if runs and c == runs[-1][1] + 1:
+            runs[-1] = (runs[-1][0], c)
+        else:
+            runs.append((c, c))
+    return tuple(runs)
+
+
+def rounded_conditions(samples: pd.DataFrame) -> list[Condition]:
+    """The (gait, frequency_hz rounded to 6 decimals) conditions present in ``samples``."""
+    known = samples["gait"].notna() & samples["frequency_hz"].notna()
+    have = samples.loc[known, ["gait", "frequency_hz"]]
+    pairs = {(str(g), round_hz(f)) for g, f in have.drop_duplicates().itertuples(index=False)}
+    return sorted(pairs, key=condition_sort_key)

@@ -1,0 +1,105 @@
+"""Experimental conditions (gait, frequency) and the option strings that name them.
+
+A condition is a tuple ``(gait, frequency_hz)`` with the frequency rounded to 6 decimals,
+as stored in `results` (1/3 Hz -> 0.333333). Option strings list conditions separated by
+commas; each item is ``GAIT@FREQ`` (one condition), ``GAIT`` (that gait at every
+frequency present) or ``@FREQ`` (every gait at that frequency); FREQ may be a fraction.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from suds_exp.campaign.errors import CampaignError
+
+#: The gait axis of the paper, in order.
+GAITS = ("S+", "S-", "O", "D-", "D+")
+
+Condition = tuple[str, float]
+
+
+def round_hz(frequency_hz: float) -> float:
+    """A frequency in Hz rounded to 6 decimals, the form stored in `results`."""
+    return round(float(frequency_hz), 6)
+
+
+def condition_sort_key(cond: Condition) -> tuple[int, float]:
+    gait, f = cond
+    return (GAITS.index(gait) if gait in GAITS else len(GAITS), f)
+
+
+def format_condition(cond: Condition) -> str:
+    """``"O@0.5"``: the condition as an option string item."""
+    return f"{cond[0]}@{cond[1]:g}"
+
+
+def _parse_hz(text: str, option: str) -> float:
+    try:
+        value = float(Fraction(text.strip()))
+    except (ValueError, ZeroDivisionError):
+        raise CampaignError(
+            f"{option}: frequency {text!r} is not a number; write e.g. 0.5 or 1/3"
+        ) from None
+    if value <= 0:
+        raise CampaignError(f"{option}: frequency {text!r} must be positive")
+    return round_hz(value)
+
+
+def select_conditions(spec: str | None, available: list[Condition], option: str) -> list[Condition]:
+    """The conditions of ``available`` named by the option string ``spec`` (None: all).
+
+    Returns them sorted along the gait axis, then by frequency; an item that matches no
+    available condition is an error naming it and what is available.
+    """
+    pool = sorted(set(available), key=condition_sort_key)
+    if spec is None or not spec.strip():
+        return pool
+    chosen: set[Condition] = set()
+    for item in (s.strip() for s in spec.split(",")):
+        if not item:
+            continue
+        gait, _, hz = item.partition("@")
+        gait = gait.strip()
+        if gait and gait not in GAITS:
+            raise CampaignError(
+                f"{option}: gait {gait!r} in {item!r}; expected one of {' '.join(GAITS)}"
+            )
+        f = _parse_hz(hz, option) if hz.strip() else None
+        match = [c for c in pool if (not gait or c[0] == gait) and (f is None or c[1] == f)]
+        if not match:
+            have = ", ".join(format_condition(c) for c in pool) or "none"
+            raise CampaignError(
+                f"{option}: {item!r} matches no condition in the samples (have: {have})"
+            )
+        chosen.update(match)
+    return sorted(chosen, key=condition_sort_key)
+
+
+def parse_int_list(spec: str | None, option: str) -> list[int]:
+    """``"1-10,21,30"`` -> [1, ..., 10, 21, 30] (sorted, unique); ``"paper"`` -> the
+    paper's sample-efficiency sweep; None or empty -> []."""
+    if spec is None or not spec.strip():
+        return []
+    if spec.strip() == "paper":
+        return list(PAPER_SWEEP)
+    values: set[int] = set()
+    for item in (s.strip() for s in spec.split(",")):
+        if not item:
+            continue
+        lo, dash, hi = item.partition("-")
+        try:
+            if dash:
+                values.update(range(int(lo), int(hi) + 1))
+            else:
+                values.add(int(item))
+        except ValueError:
+            raise CampaignError(
+                f"{option}: {item!r} is not an integer or a range like 1-10"
+            ) from None
+    if not values or min(values) < 1:
+        raise CampaignError(f"{option}: numbers of cycles must be integers >= 1, got {spec!r}")
+    return sorted(values)
+
+
+#: Training cycles of the paper's sample-efficiency figure.
+PAPER_SWEEP = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 21, 30, 39, 48)

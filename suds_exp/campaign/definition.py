@@ -1,0 +1,231 @@
+"""A campaign's definition: the options, the data it runs on and every learner's recipe.
+
+The definition is a JSON document stored in `campaigns.definition`. Continuing a
+campaign recomputes it from the options given (an option left out takes its stored
+value) and the samples, and refuses to go on when anything differs, naming each
+difference, since the finished rows would no longer describe the same experiment.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from suds_exp.campaign.bank import SampleBank
+from suds_exp.campaign.conditions import (
+    Condition,
+    format_condition,
+    parse_int_list,
+    select_conditions,
+)
+from suds_exp.campaign.errors import CampaignError
+
+#: The paper's learners, in its order.
+LEARNERS = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
+MODES = ("measured", "rollout")
+DEFINITION_VERSION = 1
+
+
+@dataclass
+class CampaignOptions:
+    """What a user chooses about a campaign; None means "as stored, else the default".
+
+    Parameters
+    ----------
+    prep : str
+        Preprocessing version whose samples the campaign uses.
+    models : sequence of learner names, or mapping name -> parameters
+        Learners to compare (default: the five of the paper, default parameters).
+    boots : int
+        Bootstrap draws per (train, test) pair (default 10).
+    train_cycles : int
+        Training cycles of the main grid, also the test range length (default 30).
+    sweep : sequence of int
+        Training cycles of the sample-efficiency sweep on same-condition pairs (default none).
+    train_conditions, test_conditions : str or list of (gait, frequency_hz)
+        Option string (`GAIT@FREQ`, `GAIT`, `@FREQ`, comma-separated) or conditions;
+        default every condition in the samples.
+    mode : str
+        ``measured`` or ``rollout``, passed to learners that take `mode` (SUDS ones).
+    """
+
+    prep: str | None = None
+    models: Sequence[str] | Mapping[str, Mapping[str, Any]] | None = None
+    boots: int | None = None
+    train_cycles: int | None = None
+    sweep: Sequence[int] | None = None
+    train_conditions: str | list[Condition] | None = None
+    test_conditions: str | list[Condition] | None = None
+    mode: str | None = None
+
+    @classmethod
+    def parse(cls, *, models: str | None = None, sweep: str | None = None, **rest):
+        """Options from command-line strings: ``models="TLS,GMR"``, ``sweep="1-10,21"``
+        (or ``"paper"``); the other fields as in the class."""
+        names = None if models is None else [m.strip() for m in models.split(",") if m.strip()]
+        cycles = None if sweep is None else parse_int_list(sweep, "--sweep")
+        return cls(models=names, sweep=cycles, **rest)
+
+
+DEFAULTS = CampaignOptions(
+    prep=None,
+    models=LEARNERS,
+    boots=10,
+    train_cycles=30,
+    sweep=(),
+    train_conditions=None,
+    test_conditions=None,
+    mode="measured",
+)
+
+
+def merge_stored(options: CampaignOptions, stored: dict | None) -> CampaignOptions:
+    """``options`` with every None filled from the stored definition, else the default."""
+    merged = {}
+    for f in fields(CampaignOptions):
+        value = getattr(options, f.name)
+        if value is None and stored is not None:
+            value = stored.get("options", {}).get(f.name)
+        if value is None:
+            value = getattr(DEFAULTS, f.name)
+        merged[f.name] = value
+    return CampaignOptions(**merged)
+
+
+def resolve_models(models, mode: str) -> dict[str, dict]:
+    """Learner name -> the JSON-safe `get_params()` of ``make_model(name, **params)``."""
+    from suds_exp.models import make_model
+
+    if isinstance(models, str):
+        models = [m.strip() for m in models.split(",") if m.strip()]
+    items = models.items() if isinstance(models, Mapping) else ((m, {}) for m in models)
+    out: dict[str, dict] = {}
+    for name, params in items:
+        if name in out:
+            raise CampaignError(f"--models: {name!r} is listed twice")
+        model = make_model(name, **dict(params or {}))
+        if "mode" in model.get_params(deep=False):
+            model.set_params(mode=mode)
+        out[name] = json.loads(json.dumps(model.get_params(deep=False), default=_json_default))
+    if not out:
+        raise CampaignError("--models: no learner given; expected e.g. TLS,GMR")
+    return out
+
+
+def _json_default(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, tuple | set):
+        return list(value)
+    raise TypeError(f"learner parameter {value!r} cannot be stored as JSON")
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A resolved campaign: its definition and what the runner needs from it."""
+
+    name: str
+    definition: dict
+    models: dict[str, dict]
+    train_conditions: list[Condition]
+    test_conditions: list[Condition]
+    boots: int
+    train_cycles: int
+    sweep: list[int]
+
+    @property
+    def test_cycles(self) -> int:
+        return self.train_cycles
+
+
+def make_plan(
+    name: str, options: CampaignOptions, available: list[Condition], bank_for
+) -> tuple[Plan, SampleBank]:
+    """Resolve ``options`` (already merged) against the conditions in the samples.
+
+    ``bank_for(conditions)`` builds the `SampleBank` of those conditions; the plan's
+    definition records its decimation and the trials used.
+    """
+    if not name or not name.strip():
+        raise CampaignError("campaign NAME must not be empty")
+    _check_int("--boots", options.boots, 1)
+    _check_int("--train-cycles", options.train_cycles, 1)
+    for n in options.sweep:
+        _check_int("--sweep", n, 1)
+    if options.mode not in MODES:
+        raise CampaignError(f"--mode: {options.mode!r}; expected one of {', '.join(MODES)}")
+    train = _conditions(options.train_conditions, available, "--train-conditions")
+    test = _conditions(options.test_conditions, available, "--test-conditions")
+    models = resolve_models(options.models, options.mode)
+    bank = bank_for(sorted(set(train) | set(test)))
+    sweep = sorted({int(n) for n in options.sweep})
+    stored_options = {
+        "prep": options.prep,
+        "models": models,
+        "boots": int(options.boots),
+        "train_cycles": int(options.train_cycles),
+        "sweep": sweep,
+        "train_conditions": [list(c) for c in train],
+        "test_conditions": [list(c) for c in test],
+        "mode": options.mode,
+    }
+    definition = {
+        "version": DEFINITION_VERSION,
+        "options": stored_options,
+        "test_cycles": int(options.train_cycles),
+        "samples_per_cycle": bank.samples_per_cycle,
+        "decimation": {f"{k:g}": v for k, v in bank.decimation.items()},
+        "trials": bank.describe(),
+    }
+    plan = Plan(
+        name=name,
+        definition=definition,
+        models=models,
+        train_conditions=train,
+        test_conditions=test,
+        boots=int(options.boots),
+        train_cycles=int(options.train_cycles),
+        sweep=sweep,
+    )
+    return plan, bank
+
+
+def _conditions(value, available, option) -> list[Condition]:
+    if value is None or isinstance(value, str):
+        return select_conditions(value, available, option)
+    spec = ",".join(format_condition((str(g), float(f))) for g, f in value)
+    return select_conditions(spec, available, option)
+
+
+def _check_int(option: str, value, low: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise CampaignError(f"{option}: {value!r}; expected an integer >= {low}")
+
+
+def differences(stored: dict, new: dict, prefix: str = "") -> list[str]:
+    """Human-readable ``path: old -> new`` lines for every leaf where the two differ."""
+    out: list[str] = []
+    for key in sorted(set(stored) | set(new), key=str):
+        path = f"{prefix}{key}"
+        a, b = stored.get(key, "<absent>"), new.get(key, "<absent>")
+        if isinstance(a, dict) and isinstance(b, dict):
+            out += differences(a, b, path + ".")
+        elif a != b:
+            out.append(f"{path}: {_short(a)} -> {_short(b)}")
+    return out
+
+
+def _short(value) -> str:
+    text = json.dumps(value, default=str)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def normalise(definition: dict) -> dict:
+    """The definition as it reads back from JSON (tuples -> lists, keys -> str)."""
+    return json.loads(json.dumps(definition, default=_json_default))

@@ -1,0 +1,131 @@
+"""What a worker does: run chunks of draws and return finished `results` rows.
+
+Workers never touch the database. They get the `SampleBank` (shared, read-only), a chunk
+of draws with the learners still to run on each, and the learners' parameters, and give
+back plain row dicts for the parent to write.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from datetime import UTC, datetime
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from suds_exp.campaign.bank import SampleBank
+from suds_exp.campaign.grid import Draw
+from suds_exp.campaign.sampling import draw_sample
+
+#: Columns of the `results` table, in order.
+RESULT_COLUMNS = (
+    "campaign",
+    "model",
+    "train_gait",
+    "train_frequency_hz",
+    "test_gait",
+    "test_frequency_hz",
+    "boot",
+    "n_cycles",
+    "train_trials",
+    "train_ranges",
+    "test_trial",
+    "test_range",
+    "rmse_vx",
+    "rmse_vy",
+    "rmse_wz",
+    "n_test",
+    "fit_seconds",
+    "predict_seconds",
+    "finished_at",
+    "error",
+)
+#: Columns that vary from run to run of the same job (everything else is reproducible).
+TIMING_COLUMNS = ("fit_seconds", "predict_seconds", "finished_at")
+
+Chunk = list[tuple[Draw, list[str]]]
+
+
+def run_chunk(
+    bank: SampleBank, chunk: Chunk, models: dict[str, dict], test_cycles: int
+) -> list[dict]:
+    """Rows of every job in ``chunk`` (a list of (draw, learner names)).
+
+    BLAS is limited to one thread so a job computes the same floating-point numbers in
+    the parent, in a loky worker and on a dask worker, and workers do not oversubscribe
+    the cores.
+    """
+    rows: list[dict] = []
+    with threadpool_limits(limits=1):
+        for draw, names in chunk:
+            rows.extend(run_draw(bank, draw, names, models, test_cycles))
+    return rows
+
+
+def run_draw(
+    bank: SampleBank, draw: Draw, names: list[str], models: dict[str, dict], test_cycles: int
+) -> list[dict]:
+    """Fit and test each learner in ``names`` on the draw's cycles; one row per learner."""
+    from suds_exp.models import make_model
+
+    sample = draw_sample(bank, draw, test_cycles)
+    train = bank.frame([bank.rows(*r) for r in sample.train])
+    test = bank.frame([bank.rows(*sample.test)])
+    truth = test[["vx", "vy", "wz"]].to_numpy()
+    ids = bank.trial_ids
+    common = {
+        "campaign": draw.campaign,
+        "train_gait": draw.train[0],
+        "train_frequency_hz": draw.train[1],
+        "test_gait": draw.test[0],
+        "test_frequency_hz": draw.test[1],
+        "boot": draw.boot,
+        "n_cycles": draw.n_cycles,
+        "train_trials": json.dumps(list(dict.fromkeys(int(ids[i]) for i, _, _ in sample.train))),
+        "train_ranges": json.dumps([[int(ids[i]), a, b] for i, a, b in sample.train]),
+        "test_trial": int(ids[sample.test[0]]),
+        "test_range": json.dumps([sample.test[1], sample.test[2]]),
+        "n_test": len(test),
+    }
+    rows = []
+    for name in names:
+        params = dict(models[name])
+        if "random_state" in params and params["random_state"] is None:
+            params["random_state"] = draw.model_seed(name)
+        rmse = (np.nan, np.nan, np.nan)
+        error = None
+        fit_s = predict_s = 0.0
+        try:
+            model = make_model(name, **params)
+            t0 = time.perf_counter()
+            model.fit(train.copy())
+            t1 = time.perf_counter()
+            pred = model.predict(test.copy())
+            t2 = time.perf_counter()
+            fit_s, predict_s = t1 - t0, t2 - t1
+            err = pred[["vx", "vy", "wz"]].to_numpy(dtype=float) - truth
+            rmse = tuple(float(v) for v in np.sqrt(np.mean(err**2, axis=0)))
+            if not np.all(np.isfinite(rmse)):
+                error = "prediction is not finite (NaN or inf), e.g. a diverging rollout"
+        except Exception as exc:  # noqa: BLE001 - a failed job is recorded, not retried forever
+            lines = str(exc).strip().splitlines()
+            error = f"{type(exc).__name__}: {lines[0] if lines else ''}"
+        rows.append(
+            {
+                **common,
+                "model": name,
+                "rmse_vx": _finite(rmse[0]),
+                "rmse_vy": _finite(rmse[1]),
+                "rmse_wz": _finite(rmse[2]),
+                "fit_seconds": fit_s,
+                "predict_seconds": predict_s,
+                "finished_at": datetime.now(UTC).replace(tzinfo=None),
+                "error": error,
+            }
+        )
+    return rows
+
+
+def _finite(value: float) -> float | None:
+    return value if np.isfinite(value) else None

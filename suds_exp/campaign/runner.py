@@ -1,0 +1,442 @@
+"""`run_campaign`: create or continue a campaign and fill its `results` rows.
+
+The parent process loads the samples once, builds the `SampleBank`, works out which jobs
+are not finished yet, and hands chunks of draws to joblib workers (loky processes on this
+machine, or a dask.distributed cluster). Finished rows come back to the parent, which
+writes them in batches, each batch in one transaction, holding the database file only
+while it writes, so `suds-exp status`, `suds-exp sql` and `duckdb -readonly` can read in
+between. A file lock beside the database keeps a second run out.
+
+Stopping: Ctrl-C (or SIGTERM) stops after writing every row already received; a signal
+that arrives while a batch is being written is served after the write, so a batch is
+never written twice. `kill -9` loses at most the rows not yet written; DuckDB's
+write-ahead log makes each batch all-or-nothing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import signal
+import socket
+import tempfile
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+
+import pandas as pd
+import sqlalchemy as sa
+
+from suds_exp.campaign import tables
+from suds_exp.campaign.bank import SampleBank, rounded_conditions
+from suds_exp.campaign.definition import (
+    CampaignOptions,
+    Plan,
+    differences,
+    make_plan,
+    merge_stored,
+    normalise,
+)
+from suds_exp.campaign.errors import CampaignError
+from suds_exp.campaign.grid import enumerate_draws
+from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
+from suds_exp.campaign.lock import RunLock
+from suds_exp.campaign.progress import job_progress
+from suds_exp.campaign.sampling import check_feasible
+from suds_exp.store import Store
+
+BACKENDS = ("loky", "dask")
+#: A batch is written when it holds this many rows ...
+BATCH_ROWS = 500
+#: ... or when this many seconds passed since the last write, whichever comes first.
+FLUSH_SECONDS = 5.0
+
+
+@dataclass
+class RunSummary:
+    """What a call of `run_campaign` did."""
+
+    campaign: str
+    total_jobs: int
+    done_before: int
+    done_now: int = 0
+    failed_now: int = 0
+    interrupted: bool = False
+    seconds: float = 0.0
+    batches: int = 0
+    flush_seconds: float = 0.0
+    created: bool = False
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def remaining(self) -> int:
+        return self.total_jobs - self.done_before - self.done_now
+
+    def message(self) -> str:
+        """One line for the terminal."""
+        head = f"campaign {self.campaign!r}: " + ("created; " if self.created else "")
+        if self.done_now == 0 and self.remaining == 0 and not self.interrupted:
+            return head + f"all {self.total_jobs} jobs were already done"
+        text = head + f"{self.done_now} jobs run in {self.seconds:.1f} s"
+        if self.failed_now:
+            text += f" ({self.failed_now} failed: see results.error)"
+        text += f"; {self.total_jobs - self.remaining} / {self.total_jobs} done"
+        if self.interrupted:
+            text += "; stopped - run the same command again to continue"
+        return text
+
+    def to_dict(self) -> dict:
+        return {
+            "campaign": self.campaign,
+            "created": self.created,
+            "total_jobs": self.total_jobs,
+            "done_before": self.done_before,
+            "done_now": self.done_now,
+            "failed_now": self.failed_now,
+            "remaining": self.remaining,
+            "interrupted": self.interrupted,
+            "seconds": self.seconds,
+        }
+
+
+def load_stored_definition(store: Store, name: str) -> dict | None:
+    """The stored definition of campaign ``name``, or None when it does not exist."""
+    if not store.path.exists():
+        return None
+    with store.read() as conn:
+        row = conn.execute(
+            sa.select(tables.campaigns.c.definition).where(tables.campaigns.c.name == name)
+        ).first()
+    return None if row is None else normalise(json.loads(row[0]))
+
+
+def finished_keys(store: Store, name: str) -> set[tuple]:
+    """Job keys (model, train gait, train Hz, test gait, test Hz, boot, n_cycles) done."""
+    frame = store.query_df(
+        "SELECT model, train_gait, train_frequency_hz, test_gait, test_frequency_hz, boot, "
+        "n_cycles FROM results WHERE campaign = ?",
+        [name],
+    )
+    return set(zip(*(frame[c].tolist() for c in frame.columns), strict=True))
+
+
+def pending_chunks(plan: Plan, done: set[tuple], chunk_jobs: int) -> tuple[list[Chunk], int, int]:
+    """Chunks of (draw, learners still to run) holding about ``chunk_jobs`` jobs each.
+
+    Returns (chunks, total jobs of the campaign, pending jobs).
+    """
+    draws = enumerate_draws(
+        plan.name,
+        plan.train_conditions,
+        plan.test_conditions,
+        plan.boots,
+        plan.train_cycles,
+        plan.sweep,
+    )
+    names = list(plan.models)
+    chunks: list[Chunk] = []
+    current: Chunk = []
+    size = pending = 0
+    for d in draws:
+        todo = [
+            m
+            for m in names
+            if (m, d.train[0], d.train[1], d.test[0], d.test[1], d.boot, d.n_cycles) not in done
+        ]
+        if not todo:
+            continue
+        current.append((d, todo))
+        size += len(todo)
+        pending += len(todo)
+        if size >= chunk_jobs:
+            chunks.append(current)
+            current, size = [], 0
+    if current:
+        chunks.append(current)
+    return chunks, len(draws) * len(names), pending
+
+
+def _max_cycles(plan: Plan) -> dict:
+    tests = set(plan.test_conditions)
+    return {
+        c: max([plan.train_cycles, *(plan.sweep if c in tests else [])])
+        for c in plan.train_conditions
+    }
+
+
+def run_campaign(
+    store: Store,
+    name: str,
+    options: CampaignOptions | None = None,
+    *,
+    samples: pd.DataFrame | None = None,
+    jobs: int = 1,
+    backend: str = "loky",
+    scheduler: str | None = None,
+    chunk_jobs: int | None = None,
+    batch_rows: int = BATCH_ROWS,
+    flush_seconds: float = FLUSH_SECONDS,
+    progress: bool = True,
+    on_batch=None,
+) -> RunSummary:
+    """Create campaign ``name`` or continue it, and run its unfinished jobs.
+
+    Parameters
+    ----------
+    store : Store
+    name : str
+        Campaign name (the `campaign` column of `results`).
+    options : CampaignOptions, optional
+        None fields take the stored value (continuing) or the default (creating).
+    samples : DataFrame, optional
+        A samples frame (columns of `samples` plus `gait`, `frequency_hz`) to use instead
+        of ``load_samples(store, options.prep)``; ``options.prep`` then only labels it.
+    jobs : int
+        Worker processes (loky) or, with dask, how many jobs run at once (-1: all
+        workers); 1 runs in this process.
+    backend : {"loky", "dask"}
+    scheduler : str, optional
+        dask scheduler address (``tcp://host:8786``); None with dask starts a local
+        cluster of ``jobs`` single-threaded workers.
+    chunk_jobs : int, optional
+        Jobs per task sent to a worker (default: enough for ~30 tasks per worker, 1-64).
+    batch_rows, flush_seconds : int, float
+        Write finished rows when this many are waiting or this long after the last write.
+    progress : bool
+        Draw a progress bar with rate and ETA on stderr.
+    on_batch : callable, optional
+        Called with the number of rows after each write (tests, notebooks).
+
+    Returns
+    -------
+    RunSummary
+    """
+    if backend not in BACKENDS:
+        raise CampaignError(f"--backend: {backend!r}; expected one of {', '.join(BACKENDS)}")
+    if scheduler and backend != "dask":
+        raise CampaignError("--scheduler needs --backend dask")
+    if jobs == 0 or jobs < -1:
+        raise CampaignError(f"--jobs: {jobs}; expected a positive number of workers (or -1)")
+    options = options or CampaignOptions()
+    started = time.perf_counter()
+    with RunLock(store.path, name):
+        store.upgrade()
+        stored = load_stored_definition(store, name)
+        options = merge_stored(options, stored)
+        if samples is None:
+            from suds_exp.preprocess import load_samples
+
+            if options.prep is None:
+                raise CampaignError("--prep: name the preprocessing version to run on")
+            samples = load_samples(store, options.prep)
+        elif options.prep is None:
+            options.prep = "(samples given)"
+        plan, bank = make_plan(
+            name, options, rounded_conditions(samples), lambda c: SampleBank.build(samples, c)
+        )
+        if stored is not None:
+            diff = differences(stored, normalise(plan.definition))
+            if diff:
+                raise CampaignError(
+                    f"campaign {name!r} exists with a different definition ("
+                    + "; ".join(diff[:6])
+                    + (f"; and {len(diff) - 6} more" if len(diff) > 6 else "")
+                    + "); continue it with its stored options or choose a new NAME"
+                )
+        check_feasible(bank, plan.train_conditions, plan.test_conditions, _max_cycles(plan))
+        done = finished_keys(store, name) if stored is not None else set()
+        n_workers = _n_workers(jobs, backend, scheduler)
+        chunks, total, pending = pending_chunks(
+            plan, done, chunk_jobs or _default_chunk(len(done), plan, n_workers)
+        )
+        summary = RunSummary(name, total, total - pending, created=stored is None)
+        _record_start(store, plan, stored is None, total, backend, n_workers, pending)
+        if pending:
+            _execute(
+                store,
+                plan,
+                bank,
+                chunks,
+                summary,
+                jobs,
+                backend,
+                scheduler,
+                batch_rows,
+                flush_seconds,
+                progress,
+                on_batch,
+            )
+    summary.seconds = time.perf_counter() - started
+    return summary
+
+
+def _n_workers(jobs: int, backend: str, scheduler: str | None) -> int:
+    if jobs == -1:
+        return os.cpu_count() or 1
+    return jobs
+
+
+def _default_chunk(_done: int, plan: Plan, n_workers: int) -> int:
+    if n_workers <= 1:
+        return len(plan.models)
+    total = len(plan.train_conditions) * len(plan.test_conditions) * plan.boots * len(plan.models)
+    return int(min(64, max(1, math.ceil(total / (n_workers * 30)))))
+
+
+def _record_start(store, plan, create, total, backend, n_workers, pending) -> None:
+    now = datetime.now(UTC).replace(tzinfo=None)
+    with store.write() as conn:
+        if create:
+            conn.execute(
+                tables.campaigns.insert().values(
+                    name=plan.name,
+                    prep_version=str(plan.definition["options"]["prep"]),
+                    definition=json.dumps(plan.definition),
+                    n_jobs=total,
+                    created_at=now,
+                )
+            )
+        conn.execute(
+            tables.campaign_runs.insert().values(
+                campaign=plan.name,
+                started_at=now,
+                pid=os.getpid(),
+                host=socket.gethostname(),
+                backend=backend if n_workers != 1 or backend == "dask" else "in-process",
+                n_workers=n_workers,
+                n_pending=pending,
+            )
+        )
+
+
+class _Signals:
+    """Turn SIGINT/SIGTERM into KeyboardInterrupt, but never in the middle of a write."""
+
+    def __init__(self):
+        self.critical = False
+        self.pending = False
+        self._old: dict = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+    def _handle(self, signum, frame):
+        if self.critical:
+            self.pending = True
+            return
+        raise KeyboardInterrupt
+
+    @contextlib.contextmanager
+    def shielded(self) -> Iterator[None]:
+        self.critical = True
+        try:
+            yield
+        finally:
+            self.critical = False
+        if self.pending:
+            self.pending = False
+            raise KeyboardInterrupt
+
+
+def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextlib.ExitStack):
+    args = (plan.models, plan.test_cycles)
+    if backend == "loky" and jobs == 1:
+        return (run_chunk(bank, c, *args) for c in chunks)
+    from joblib import Parallel, delayed, parallel_config
+
+    if backend == "loky":
+        folder = stack.enter_context(tempfile.TemporaryDirectory(prefix="suds_bank_"))
+        shared = bank.memmapped(folder)
+        stack.enter_context(parallel_config(backend="loky", n_jobs=jobs))
+    else:
+        from dask.distributed import Client, LocalCluster
+
+        if scheduler:
+            client = stack.enter_context(Client(scheduler))
+        else:
+            cluster = stack.enter_context(
+                LocalCluster(
+                    n_workers=max(jobs, 1),
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                )
+            )
+            client = stack.enter_context(Client(cluster))
+        shared = bank
+        stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
+        del client
+    gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
+        delayed(run_chunk)(shared, c, *args) for c in chunks
+    )
+    stack.callback(getattr(gen, "close", lambda: None))
+    return gen
+
+
+def _execute(
+    store,
+    plan,
+    bank,
+    chunks,
+    summary,
+    jobs,
+    backend,
+    scheduler,
+    batch_rows,
+    flush_seconds,
+    progress,
+    on_batch,
+) -> None:
+    buffer: list[dict] = []
+
+    def flush():
+        if not buffer:
+            return
+        t0 = time.perf_counter()
+        with signals.shielded():
+            frame = pd.DataFrame(buffer, columns=list(RESULT_COLUMNS))
+            with store.write() as conn:
+                store.insert_df(conn, "results", frame)
+            summary.done_now += len(frame)
+            summary.failed_now += int(frame["error"].notna().sum())
+            summary.batches += 1
+            buffer.clear()
+        summary.flush_seconds += time.perf_counter() - t0
+        if on_batch is not None:
+            on_batch(len(frame))
+
+    with (
+        _Signals() as signals,
+        job_progress(
+            f"campaign {plan.name}", summary.total_jobs, summary.done_before, enabled=progress
+        ) as advance,
+    ):
+        last = time.monotonic()
+        try:
+            with contextlib.ExitStack() as stack:
+                for rows in _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack):
+                    buffer.extend(rows)
+                    advance(len(rows))
+                    if len(buffer) >= batch_rows or time.monotonic() - last >= flush_seconds:
+                        flush()
+                        last = time.monotonic()
+        except KeyboardInterrupt:
+            summary.interrupted = True
+        finally:
+            # Rows already received are written even when stopping or failing: a stop
+            # loses no finished work. A second Ctrl-C during this write is served after it.
+            try:
+                flush()
+            except KeyboardInterrupt:
+                summary.interrupted = True

@@ -1,0 +1,128 @@
+"""`campaign_status`: how far a campaign is, how fast it goes, and when it will finish."""
+
+from __future__ import annotations
+
+import json
+from datetime import UTC, datetime
+
+import pandas as pd
+
+from suds_exp.campaign.errors import CampaignError
+from suds_exp.campaign.lock import run_holder
+from suds_exp.store import Store
+
+
+def campaign_status(store: Store, name: str) -> dict:
+    """Progress of campaign ``name`` (read-only; waits briefly if a run is writing).
+
+    Returns a dict: ``campaign``, ``prep``, ``done``, ``total``, ``failed`` (jobs whose
+    learner raised or predicted non-finite values), ``models`` (list of {model, done,
+    total, failed}), ``running`` (whether a run holds the database and works on this
+    campaign), ``last_run_started`` (UTC), ``rate_jobs_per_s`` (jobs finished per second
+    during the last run, None before any), ``eta_s`` (seconds left at that rate while
+    running, else None).
+    """
+    with store.read() as conn:
+        raw = conn.connection.driver_connection
+        has = raw.execute(
+            "SELECT count(*) FROM information_schema.tables WHERE table_name = 'campaigns'"
+        ).fetchone()[0]
+        row = (
+            raw.execute(
+                "SELECT definition, n_jobs, prep_version FROM campaigns WHERE name = ?", [name]
+            ).fetchone()
+            if has
+            else None
+        )
+        if row is None:
+            names = (
+                [r[0] for r in raw.execute("SELECT name FROM campaigns ORDER BY 1").fetchall()]
+                if has
+                else []
+            )
+            raise CampaignError(
+                f"no campaign {name!r} in {store.path} (have: {', '.join(names) or 'none'}); "
+                "start one with `suds-exp run NAME`"
+            )
+        definition, total, prep = json.loads(row[0]), int(row[1]), row[2]
+        per_model = raw.execute(
+            "SELECT model, count(*) AS done, count(error) AS failed FROM results "
+            "WHERE campaign = ? GROUP BY model",
+            [name],
+        ).df()
+        last_run = raw.execute(
+            "SELECT started_at FROM campaign_runs WHERE campaign = ? ORDER BY id DESC LIMIT 1",
+            [name],
+        ).fetchone()
+        started = last_run[0] if last_run else None
+        since = (
+            raw.execute(
+                "SELECT count(*), max(finished_at) FROM results "
+                "WHERE campaign = ? AND finished_at >= ?",
+                [name, started],
+            ).fetchone()
+            if started is not None
+            else (0, None)
+        )
+    models = list(definition["options"]["models"])
+    per_job = total // max(len(models), 1)
+    counts = per_model.set_index("model") if len(per_model) else pd.DataFrame()
+    table = [
+        {
+            "model": m,
+            "done": int(counts.loc[m, "done"]) if m in counts.index else 0,
+            "total": per_job,
+            "failed": int(counts.loc[m, "failed"]) if m in counts.index else 0,
+        }
+        for m in models
+    ]
+    done = sum(r["done"] for r in table)
+    holder = run_holder(store.path)
+    running = bool(holder) and holder.get("campaign") in (name, None)
+    now = datetime.now(UTC).replace(tzinfo=None)
+    rate = None
+    if started is not None and since[0]:
+        end = now if running else since[1]
+        seconds = (end - started).total_seconds()
+        rate = since[0] / seconds if seconds > 0 else None
+    eta = (total - done) / rate if running and rate else None
+    return {
+        "campaign": name,
+        "prep": prep,
+        "done": done,
+        "total": total,
+        "failed": sum(r["failed"] for r in table),
+        "models": table,
+        "running": running,
+        "last_run_started": started,
+        "rate_jobs_per_s": rate,
+        "eta_s": eta,
+    }
+
+
+def print_status(status: dict) -> None:
+    """Print `campaign_status` as a per-learner table and one summary line."""
+    from suds_exp import console
+
+    frame = pd.DataFrame(status["models"])
+    console.print_frame(frame, title=f"campaign {status['campaign']} (prep {status['prep']})")
+    rate = status["rate_jobs_per_s"]
+    line = f"{status['done']} / {status['total']} jobs done"
+    if status["failed"]:
+        line += f", {status['failed']} failed (see results.error)"
+    if status["running"]:
+        line += " - running"
+        if rate:
+            line += f" at {rate:.2f} jobs/s, about {_duration(status['eta_s'])} left"
+    elif rate:
+        line += f" - not running (last run: {rate:.2f} jobs/s)"
+    console.out.print(line)
+
+
+def _duration(seconds: float | None) -> str:
+    if seconds is None:
+        return "?"
+    seconds = int(round(seconds))
+    h, rem = divmod(seconds, 3600)
+    m, s = divmod(rem, 60)
+    return f"{h}h{m:02d}m" if h else (f"{m}m{s:02d}s" if m else f"{s}s")

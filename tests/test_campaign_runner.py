@@ -1,0 +1,169 @@
+"""Running, resuming and refusing campaigns (library API, CLI and SQL on the DB)."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+import cli
+from suds_exp.campaign import (
+    KEY_COLUMNS,
+    TIMING_COLUMNS,
+    CampaignError,
+    CampaignOptions,
+    campaign_status,
+    run_campaign,
+)
+from suds_exp.campaign.lock import RunLock
+from suds_exp.store import Store
+from tests.test_campaign_grid import synthetic_samples
+
+OPTIONS = dict(models=["phase-only", "TLS"], boots=2, train_cycles=4, sweep=[1, 2])
+
+
+@pytest.fixture(scope="module")
+def samples() -> pd.DataFrame:
+    return synthetic_samples()
+
+
+def results(store: Store, campaign: str = "c") -> pd.DataFrame:
+    frame = store.query_df("SELECT * FROM results WHERE campaign = ? ORDER BY ALL", [campaign])
+    return frame.drop(columns=list(TIMING_COLUMNS)).sort_values(
+        list(KEY_COLUMNS), ignore_index=True
+    )
+
+
+def test_a_campaign_fills_one_row_per_job(db, samples):
+    store = Store(db)
+    summary = run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    # 4 conditions: 16 pairs x 2 boots + 4 same-condition pairs x 2 boots x 2 sweep values
+    assert summary.total_jobs == (16 * 2 + 4 * 2 * 2) * 2
+    assert summary.done_now == summary.total_jobs and summary.failed_now == 0
+    frame = results(store)
+    assert len(frame) == summary.total_jobs
+    assert not frame.duplicated(list(KEY_COLUMNS)).any()
+    assert frame.error.isna().all() and (frame.rmse_vx > 0).all()
+    assert set(frame.n_cycles) == {1, 2, 4}
+    for row in frame.itertuples():
+        ranges = json.loads(row.train_ranges)
+        assert sum(b - a + 1 for _, a, b in ranges) == row.n_cycles
+        assert row.test_trial not in json.loads(row.train_trials)
+        a, b = json.loads(row.test_range)
+        assert b - a + 1 == 4
+    # the paired design: every learner sees the same draw
+    per_draw = frame.groupby(
+        ["train_gait", "train_frequency_hz", "test_gait", "test_frequency_hz", "boot", "n_cycles"]
+    )
+    assert (per_draw.train_ranges.nunique() == 1).all()
+    assert (per_draw.test_range.nunique() == 1).all()
+    # the definition holds every option and every learner's parameters
+    (definition,) = store.query_df("SELECT definition FROM campaigns WHERE name = 'c'").definition
+    stored = json.loads(definition)["options"]
+    assert stored["boots"] == 2 and stored["sweep"] == [1, 2]
+    assert stored["models"]["phase-only"] == {"order": 6}
+    status = campaign_status(store, "c")
+    assert status["done"] == status["total"] == summary.total_jobs
+    assert [m["done"] for m in status["models"]] == [summary.total_jobs // 2] * 2
+
+
+def test_resume_skips_finished_jobs_and_reproduces_the_rest(db, tmp_path, samples):
+    store = Store(db)
+    full = Store(tmp_path / "full.duckdb")
+    run_campaign(full, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    # a partial run: keep some finished rows, as a stop would
+    run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    with store.write() as conn:
+        conn.exec_driver_sql("DELETE FROM results WHERE boot = 1 OR model = 'TLS' AND n_cycles = 1")
+    kept = len(results(store))
+    again = run_campaign(store, "c", CampaignOptions(), samples=samples, progress=False)
+    assert again.done_before == kept and again.done_now == again.total_jobs - kept
+    pd.testing.assert_frame_equal(results(store), results(full), check_exact=True)
+    nothing = run_campaign(store, "c", samples=samples, progress=False)
+    assert nothing.done_now == 0 and "already done" in nothing.message()
+
+
+def test_continuing_with_changed_options_is_refused_naming_the_differences(db, samples):
+    store = Store(db)
+    run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    before = results(store)
+    with pytest.raises(CampaignError, match=r"boots: 2 -> 3"):
+        run_campaign(store, "c", CampaignOptions(boots=3), samples=samples, progress=False)
+    with pytest.raises(CampaignError, match=r"models\.TLS\.n_bins"):
+        changed = {"phase-only": {}, "TLS": {"n_bins": 7}}
+        run_campaign(store, "c", CampaignOptions(models=changed), samples=samples, progress=False)
+    with pytest.raises(CampaignError, match=r"trials"):
+        fewer = samples[samples.trial_id != 3]
+        run_campaign(store, "c", samples=fewer, progress=False)
+    pd.testing.assert_frame_equal(results(store), before)
+
+
+def test_a_second_run_on_the_same_database_is_refused(db, samples):
+    store = Store(db)
+    with (
+        RunLock(db, "other"),
+        pytest.raises(CampaignError, match="another `suds-exp run`.*'other'"),
+    ):
+        run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+
+
+def test_bad_options_are_refused_before_any_work(db, samples):
+    store = Store(db)
+    cases = [
+        (CampaignOptions(models=["TLS", "nope"]), "nope"),
+        (CampaignOptions(boots=0), "--boots"),
+        (CampaignOptions(mode="sometimes"), "--mode"),
+        (CampaignOptions(train_conditions="S+@2"), "--train-conditions"),
+        (CampaignOptions(train_cycles=200), "O@0.5"),
+    ]
+    for options, message in cases:
+        with pytest.raises(Exception, match=message):
+            run_campaign(store, "c", options, samples=samples, progress=False)
+    assert store.query_df("SELECT count(*) AS n FROM campaigns").n[0] == 0
+
+
+def test_cli_run_and_status(db, samples, monkeypatch):
+    import suds_exp.preprocess as preprocess
+
+    seen = []
+
+    def fake_load(store, version):
+        seen.append(version)
+        return samples
+
+    monkeypatch.setattr(preprocess, "load_samples", fake_load, raising=False)
+    runner = CliRunner()
+    args = [
+        "run",
+        "c",
+        "--db",
+        str(db),
+        "--prep",
+        "v1",
+        "--models",
+        "phase-only",
+        "--boots",
+        "1",
+        "--train-cycles",
+        "3",
+        "--train-conditions",
+        "O",
+        "--json",
+    ]
+    out = runner.invoke(cli.app, args)
+    assert out.exit_code == 0, out.output
+    doc = json.loads(out.stdout)
+    assert doc["done_now"] == doc["total_jobs"] == 8 and seen == ["v1"]
+    out = runner.invoke(cli.app, ["status", "c", "--db", str(db), "--json"])
+    assert out.exit_code == 0, out.output
+    status = json.loads(out.stdout)
+    assert status["done"] == 8 and status["prep"] == "v1" and not status["running"]
+    out = runner.invoke(cli.app, ["status", "c", "--db", str(db)])
+    assert "8 / 8 jobs done" in out.stdout
+    out = runner.invoke(cli.app, ["run", "c", "--db", str(db), "--boots", "2"])
+    assert out.exit_code == 2 and "boots: 1 -> 2" in out.output
+    out = runner.invoke(cli.app, ["status", "nope", "--db", str(db)])
+    assert out.exit_code == 2 and "no campaign 'nope'" in out.output
