@@ -1,0 +1,211 @@
+"""Simulated capture sessions: gait command -> actuator -> physics -> markers -> files.
+
+Every trial's random numbers come from its own seed derived from
+(seed, gait, frequency, repeat), so a trial's files do not depend on which other trials
+are simulated with it or in which order; same seed, same files, byte for byte.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from suds_exp.errors import ConfigError
+from suds_exp.sim.config import SimConfig
+from suds_exp.sim.files import write_manifest, write_qtm_tsv, write_truth
+from suds_exp.sim.gaits import FREQUENCIES_HZ, GAITS, actuate, gait_shape
+from suds_exp.sim.markers import MARKER_NAMES, measure, true_marker_positions
+from suds_exp.sim.mechanics import simulate_prescribed
+
+_GAIT_FILE_CODE = {"S+": "Sp", "S-": "Sm", "O": "O", "D-": "Dm", "D+": "Dp"}
+_EPOCH = _dt.datetime(2026, 1, 1, 9, 0, 0)
+
+
+@dataclass(frozen=True)
+class TrialSpec:
+    """One simulated trial: condition, its seed-derived randomness, and its drive."""
+
+    gait: str
+    frequency_hz: float
+    repeat: int
+    n_cycles: int
+    phase0: float
+    pose0: tuple[float, float, float]
+    seed: tuple[int, ...]
+
+    @property
+    def name(self) -> str:
+        mhz = int(round(self.frequency_hz * 1000))
+        return f"sim_{_GAIT_FILE_CODE[self.gait]}_{mhz:04d}mHz_r{self.repeat:02d}"
+
+
+@dataclass(frozen=True)
+class SimulatedDataset:
+    """Paths written by `simulate_dataset` (TSV files in trial order)."""
+
+    tsv_paths: list[Path]
+    truth_paths: list[Path]
+    manifest: Path
+    simulated_seconds: float
+
+
+def trial_seed(seed: int, gait: str, frequency_hz: float, repeat: int) -> tuple[int, ...]:
+    """Entropy of one trial: independent of loop order and of the other trials."""
+    return (int(seed), GAITS.index(gait), int(round(frequency_hz * 1e6)), int(repeat))
+
+
+def plan_trials(
+    gaits: Sequence[str] = GAITS,
+    frequencies_hz: Sequence[float] = FREQUENCIES_HZ,
+    repeats: int = 4,
+    cycles: tuple[int, int] = (10, 30),
+    seed: int = 0,
+) -> list[TrialSpec]:
+    """Trial specs of a gait x frequency x repeat design (repeats numbered from 1)."""
+    for g in gaits:
+        if g not in GAITS:
+            raise ConfigError(f"gait {g!r}: expected one of {', '.join(GAITS)}")
+    for f in frequencies_hz:
+        if not f > 0:
+            raise ConfigError(f"frequency {f!r}: must be > 0 Hz")
+    if repeats < 1:
+        raise ConfigError(f"repeats {repeats}: must be >= 1")
+    lo, hi = cycles
+    if not 1 <= lo <= hi:
+        raise ConfigError(f"cycles {lo}:{hi}: expected 1 <= MIN <= MAX")
+    specs = []
+    for g in gaits:
+        for f in frequencies_hz:
+            for r in range(1, repeats + 1):
+                ent = trial_seed(seed, g, f, r)
+                rng = np.random.default_rng(np.random.SeedSequence(ent + (0,)))
+                specs.append(
+                    TrialSpec(
+                        gait=g,
+                        frequency_hz=float(f),
+                        repeat=r,
+                        n_cycles=int(rng.integers(lo, hi + 1)),
+                        phase0=float(rng.uniform(0, 2 * math.pi)),
+                        pose0=(
+                            float(rng.uniform(-300, 300)),
+                            float(rng.uniform(-300, 300)),
+                            float(rng.uniform(-math.pi, math.pi)),
+                        ),
+                        seed=ent,
+                    )
+                )
+    return specs
+
+
+def drive(spec: TrialSpec, cfg: SimConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(t (n,) s, commanded phase (n,) rad, realised phi (n, 2) rad) of one trial."""
+    rate = cfg.measurement.sample_rate_hz
+    n = int(round(spec.n_cycles / spec.frequency_hz * rate)) + 1
+    t = np.arange(n) / rate
+    phase = 2 * math.pi * spec.frequency_hz * t + spec.phase0
+    rng = np.random.default_rng(np.random.SeedSequence(spec.seed + (1,)))
+    phi = actuate(gait_shape(spec.gait, phase), 1 / rate, cfg.actuator, rng)
+    return t, phase, phi
+
+
+def simulate_trials(specs: list[TrialSpec], cfg: SimConfig) -> list[dict[str, np.ndarray]]:
+    """Simulate trials in one batched physics call; one truth-column dict per trial."""
+    drives = [drive(s, cfg) for s in specs]
+    if not specs:
+        return []
+    n_max = max(len(d[0]) for d in drives)
+    phi = np.zeros((len(specs), n_max, 2))
+    lengths = np.array([len(d[0]) for d in drives])
+    for k, (_, _, p) in enumerate(drives):
+        phi[k, : len(p)] = p
+    out = simulate_prescribed(
+        phi,
+        1 / cfg.measurement.sample_rate_hz,
+        cfg,
+        pose0=np.array([s.pose0 for s in specs]),
+        n_frames=lengths,
+    )
+    truths = []
+    for k, (t, phase, p) in enumerate(drives):
+        n = len(t)
+        cols = {"t": t, "phase_cmd": phase, "phi1": p[:, 0], "phi2": p[:, 1]}
+        for j, c in enumerate(("x", "y", "theta")):
+            cols[c] = out["pose"][k, :n, j]
+        for j, c in enumerate(("vx", "vy", "wz")):
+            cols[c] = out["vel"][k, :n, j]
+        for i in range(4):
+            cols[f"flipper_{i + 1}"] = out["flippers"][k, :n, i]
+        cols["residual"] = out["residual"][k, :n]
+        truths.append(cols)
+    return truths
+
+
+def truth_markers(truth: dict | object, cfg: SimConfig) -> np.ndarray:
+    """Noise-free marker positions (n, 11, 3), mm, of a truth table (dict or DataFrame)."""
+    pose = np.column_stack([np.asarray(truth[c]) for c in ("x", "y", "theta")])
+    phi = np.column_stack([np.asarray(truth["phi1"]), np.asarray(truth["phi2"])])
+    fl = np.column_stack([np.asarray(truth[f"flipper_{i}"]) for i in range(1, 5)])
+    return true_marker_positions(cfg, pose, phi, fl, 1 / cfg.measurement.sample_rate_hz)
+
+
+def simulate_dataset(
+    out_dir: str | Path,
+    config: SimConfig | None = None,
+    gaits: Sequence[str] = GAITS,
+    frequencies_hz: Sequence[float] = FREQUENCIES_HZ,
+    repeats: int = 4,
+    cycles: tuple[int, int] = (10, 30),
+    seed: int = 0,
+    progress: Callable[[int, int], None] | None = None,
+    batch_size: int = 20,
+) -> SimulatedDataset:
+    """Simulate a gait x frequency x repeat design and write its files into out_dir.
+
+    Writes `<trial>.tsv` (QTM export of the 11 markers), `<trial>.truth.parquet` and
+    `manifest.csv`. Default: the paper's design, 5 gaits x 3 frequencies x 4 repeats,
+    10-30 cycles each. `progress(done, total)` is called after each written trial.
+    """
+    cfg = SimConfig() if config is None else config
+    out = Path(out_dir)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"{out}: cannot create output folder ({exc.strerror})") from None
+    specs = plan_trials(gaits, frequencies_hz, repeats, cycles, seed)
+    rows, tsvs, truths_written = [], [], []
+    seconds = 0.0
+    rate = cfg.measurement.sample_rate_hz
+    for start in range(0, len(specs), batch_size):
+        batch = specs[start : start + batch_size]
+        for spec, truth in zip(batch, simulate_trials(batch, cfg), strict=True):
+            rng = np.random.default_rng(np.random.SeedSequence(spec.seed + (2,)))
+            measured = measure(cfg, truth_markers(truth, cfg), rng)
+            tsv = out / f"{spec.name}.tsv"
+            # a plausible session clock: one hour per gait, a minute per repeat
+            g, mhz, r = spec.seed[1], spec.seed[2] // 1000, spec.seed[3]
+            stamp = _EPOCH + _dt.timedelta(seconds=3600 * g + 60 * r + mhz)
+            write_qtm_tsv(tsv, measured, MARKER_NAMES, rate, stamp)
+            truth_path = out / f"{spec.name}.truth.parquet"
+            write_truth(truth_path, truth)
+            seconds += truth["t"][-1]
+            rows.append(
+                {
+                    "file": tsv.name,
+                    "gait": spec.gait,
+                    "frequency_hz": f"{spec.frequency_hz:.6f}",
+                    "repeat": spec.repeat,
+                    "notes": f"simulated seed={spec.seed[0]} cycles={spec.n_cycles}",
+                }
+            )
+            tsvs.append(tsv)
+            truths_written.append(truth_path)
+            if progress is not None:
+                progress(len(tsvs), len(specs))
+    manifest = out / "manifest.csv"
+    write_manifest(manifest, rows)
+    return SimulatedDataset(tsvs, truths_written, manifest, seconds)

@@ -1,0 +1,252 @@
+"""The swimmer's mechanics: element tables from the geometry, and the public batched
+simulation of prescribed joint trajectories (the single physics entry point).
+
+`simulate_prescribed` is what both the gait path (command -> actuator -> physics) and the
+discrepancy workflow (replay measured phi1, phi2) call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from suds_exp.errors import ConfigError
+from suds_exp.sim import rft
+from suds_exp.sim.config import SimConfig
+
+FLIPPER_MODES = {"free": rft.FL_FREE, "locked": rft.FL_LOCKED, "absent": rft.FL_ABSENT}
+
+
+@dataclass(frozen=True)
+class ElementTable:
+    """RFT elements of the robot, in units of L_ref = middle segment length.
+
+    part (n_el,): 0 head, 1 middle, 2 tail, 3 + i flipper i; s (n_el,): element centre
+    along its segment axis in the segment frame (origin at the joint), or distance from
+    the hinge for flippers; w (n_el,): length x depth / (L_ref x segment depth).
+    Flipper i (0..3 = flipper_1..flipper_4): segment (0 head, 2 tail), hinge (hx, hy) in
+    the segment frame, side +1 left (+Y), -1 right.
+    """
+
+    part: np.ndarray
+    s: np.ndarray
+    w: np.ndarray
+    half_mid: float
+    fl_seg: np.ndarray
+    fl_hx: np.ndarray
+    fl_hy: np.ndarray
+    fl_side: np.ndarray
+    l_ref: float
+
+    def kernel_args(self) -> tuple:
+        return (
+            self.part,
+            self.s,
+            self.w,
+            self.half_mid,
+            self.fl_seg,
+            self.fl_hx,
+            self.fl_hy,
+            self.fl_side,
+        )
+
+
+def _midpoints(lo: float, hi: float, n: int) -> np.ndarray:
+    edges = np.linspace(lo, hi, n + 1)
+    return 0.5 * (edges[:-1] + edges[1:])
+
+
+def element_table(cfg: SimConfig) -> ElementTable:
+    """Discretise segments and flippers of `cfg.geometry` into RFT elements."""
+    g = cfg.geometry
+    L = g.middle_length_mm
+    n, nf = g.elements_per_segment, g.elements_per_flipper
+    parts, s, w = [], [], []
+    for part, lo, hi in (
+        (0, 0.0, g.head_length_mm),
+        (1, -L / 2, L / 2),
+        (2, -g.tail_length_mm, 0.0),
+    ):
+        parts.append(np.full(n, part))
+        s.append(_midpoints(lo, hi, n) / L)
+        w.append(np.full(n, (hi - lo) / n / L))
+    # head flippers hinge at +head_hinge along the head; tail ones at -tail_hinge
+    fl_seg = np.array([0, 0, 2, 2], dtype=np.int64)
+    fl_hx = np.array([g.head_hinge_mm, g.head_hinge_mm, -g.tail_hinge_mm, -g.tail_hinge_mm]) / L
+    fl_side = np.array([1.0, -1.0, 1.0, -1.0])
+    fl_hy = fl_side * (g.segment_width_mm / 2) / L
+    depth_ratio = g.flipper_depth_mm / g.segment_depth_mm
+    for i in range(4):
+        parts.append(np.full(nf, 3 + i))
+        s.append(_midpoints(0.0, g.flipper_length_mm, nf) / L)
+        w.append(np.full(nf, g.flipper_length_mm / nf / L * depth_ratio))
+    return ElementTable(
+        part=np.concatenate(parts).astype(np.int64),
+        s=np.concatenate(s),
+        w=np.concatenate(w),
+        half_mid=0.5,
+        fl_seg=fl_seg,
+        fl_hx=fl_hx,
+        fl_hy=fl_hy,
+        fl_side=fl_side,
+        l_ref=L,
+    )
+
+
+def pack_params(cfg: SimConfig) -> np.ndarray:
+    """Kernel parameter vector (rft.N_PARAMS,) of one configuration (scaled units)."""
+    g, m, hg, ef, sv = cfg.geometry, cfg.medium, cfg.hinges, cfg.effects, cfg.solver
+    L = g.middle_length_mm
+    force_unit = m.stress_scale_n_per_mm2 * g.segment_depth_mm * L  # N
+    torque_unit = force_unit * L  # N mm
+    p = np.zeros(rft.N_PARAMS)
+    p[rft.P_CS] = m.c_s
+    p[rft.P_CF] = m.c_f
+    p[rft.P_CL] = m.c_l
+    p[rft.P_GAMMA] = m.gamma
+    p[rft.P_EPS] = m.smoothing_rel
+    p[rft.P_MU] = m.regularization
+    p[rft.P_ASYM] = ef.asymmetric_drag.ratio
+    p[rft.P_NORMAL] = ef.drag_anisotropy.normal_scale
+    p[rft.P_COMPACT] = ef.medium_compaction.rate_per_m * L / 1000.0
+    p[rft.P_K] = hg.spring_n_mm_per_rad / torque_unit
+    p[rft.P_PRELOAD] = hg.preload_rad
+    p[rft.P_AMAX] = math.radians(hg.open_stop_deg)
+    p[rft.P_CHINGE] = ef.hinge_damping.damping / torque_unit
+    try:
+        p[rft.P_FLMODE] = FLIPPER_MODES[ef.flippers.mode]
+    except KeyError:
+        raise ConfigError(
+            f"effects.flippers.mode: {ef.flippers.mode!r}; expected {', '.join(FLIPPER_MODES)}"
+        ) from None
+    p[rft.P_FLLOCK] = math.radians(ef.flippers.locked_angle_deg)
+    p[rft.P_TAU] = ef.body_inertia.tau_s
+    p[rft.P_TOL] = sv.tol
+    p[rft.P_MAXIT] = sv.max_iter
+    p[rft.P_SFLOOR] = sv.shape_rate_floor
+    p[rft.P_LREF] = L
+    p[rft.P_SUBSTEPS] = sv.substeps
+    return p
+
+
+def residual_units(cfg: SimConfig) -> tuple[float, float]:
+    """(N, N mm) represented by one unit of the solver's scaled residual."""
+    g = cfg.geometry
+    force = cfg.medium.stress_scale_n_per_mm2 * g.segment_depth_mm * g.middle_length_mm
+    return force, force * g.middle_length_mm
+
+
+def _same_geometry(configs: list[SimConfig]) -> None:
+    first = configs[0].geometry
+    for c in configs[1:]:
+        if c.geometry != first:
+            raise ConfigError("simulate_prescribed: all configs of one batch must share geometry")
+
+
+def simulate_prescribed(
+    phi: np.ndarray,
+    dt: float,
+    config: SimConfig | list[SimConfig] | None = None,
+    pose0: np.ndarray | None = None,
+    flippers0: np.ndarray | None = None,
+    n_frames: np.ndarray | None = None,
+) -> dict[str, np.ndarray]:
+    """Simulate a batch of trials driven by prescribed joint angles.
+
+    Parameters
+    ----------
+    phi : array of shape (n_trials, n_frames, 2) or (n_frames, 2), rad
+        phi1 (head joint), phi2 (tail joint) sampled every `dt` seconds (e.g. measured).
+    dt : float, s
+        Sample interval (0.01 at 100 Hz); `config.solver.substeps` solves per interval,
+        phi linearly interpolated between samples.
+    config : SimConfig or list of n_trials SimConfig (same geometry), default nominal
+        Physics and effects (each trial may have its own effect parameters).
+    pose0 : array of shape (n_trials, 3), optional
+        Initial world pose x, y (mm), theta (rad) of the body frame; default zeros.
+    flippers0 : array of shape (n_trials, 4), optional
+        Initial flipper angles (rad, 0 = closed); default closed.
+    n_frames : int array of shape (n_trials,), optional
+        Valid frames of each trial when trials of different lengths are padded.
+
+    Returns
+    -------
+    dict of arrays (n_trials, n_frames[, k]); frames past a trial's length are NaN:
+        ``pose`` (x, y mm, theta rad; world), ``vel`` (vx, vy mm/s, wz rad/s; body frame,
+        centred on each frame), ``flippers`` (4, rad), ``phi`` (2, rad, as given),
+        ``residual`` (max scaled force/torque residual of the solves ending at each frame,
+        see `residual_units`), ``iterations`` and ``continuations`` (n_trials,).
+    """
+    phi = np.asarray(phi, dtype=float)
+    single = phi.ndim == 2
+    if single:
+        phi = phi[None]
+    if phi.ndim != 3 or phi.shape[2] != 2:
+        raise ConfigError(f"phi: expected shape (n_trials, n_frames, 2), got {phi.shape}")
+    n_trials, n_max = phi.shape[:2]
+    configs = (
+        [SimConfig()] * n_trials
+        if config is None
+        else list(config)
+        if isinstance(config, list | tuple)
+        else [config] * n_trials
+    )
+    if len(configs) != n_trials:
+        raise ConfigError(f"config: got {len(configs)} configs for {n_trials} trials")
+    _same_geometry(configs)
+    table = element_table(configs[0])
+    prm = np.stack([pack_params(c) for c in configs])
+    lengths = (
+        np.full(n_trials, n_max, dtype=np.int64)
+        if n_frames is None
+        else np.asarray(n_frames, dtype=np.int64).reshape(n_trials)
+    )
+    if lengths.min(initial=1) < 1 or lengths.max(initial=0) > n_max:
+        raise ConfigError("n_frames: each trial needs 1..n_frames samples")
+    for k in range(n_trials):
+        if not np.all(np.isfinite(phi[k, : lengths[k]])):
+            raise ConfigError(f"phi: trial {k} has non-finite joint angles")
+    p0 = np.zeros((n_trials, 3)) if pose0 is None else np.asarray(pose0, float).reshape(-1, 3)
+    a0 = (
+        np.zeros((n_trials, 4))
+        if flippers0 is None
+        else np.asarray(flippers0, float).reshape(-1, 4)
+    )
+    pose = np.full((n_trials, n_max, 3), np.nan)
+    vel = np.full((n_trials, n_max, 3), np.nan)
+    ang = np.full((n_trials, n_max, 4), np.nan)
+    resid = np.full((n_trials, n_max), np.nan)
+    iters = np.zeros(n_trials, dtype=np.int64)
+    n_cont = np.zeros(n_trials, dtype=np.int64)
+    rft.run_trials(
+        np.ascontiguousarray(phi),
+        lengths,
+        p0,
+        a0,
+        prm,
+        *table.kernel_args(),
+        float(dt),
+        pose,
+        vel,
+        ang,
+        resid,
+        iters,
+        n_cont,
+    )
+    phi_out = phi.copy()
+    for k in range(n_trials):
+        phi_out[k, lengths[k] :] = np.nan
+    out = {
+        "pose": pose,
+        "vel": vel,
+        "flippers": ang,
+        "phi": phi_out,
+        "residual": resid,
+        "iterations": iters,
+        "continuations": n_cont,
+    }
+    if single:
+        out = {k: (v[0] if v.ndim > 1 else v) for k, v in out.items()}
+    return out

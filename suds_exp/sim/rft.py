@@ -1,0 +1,795 @@
+"""Compiled quasi-static granular RFT solver of the 3-segment, 4-flipper swimmer.
+
+Internal units: lengths in units of L_ref (the middle segment length), velocities in
+units of L_ref * s, where s = sqrt(|d(phi)/dt|^2 + floor^2) is the shape-rate scale of
+the step (rad/s); forces in units of sigma * depth_ref * L_ref (N), torques of that
+times L_ref (N mm). RFT forces are homogeneous of degree 0 in velocity once the
+smoothing scale is proportional to s, so the problem is solved "at unit shape rate" and
+the solution rescaled by s: the model is exactly rate independent unless hinge damping
+(which is multiplied by s) or body inertia are on.
+
+Unknowns of every step x = (vx, vy, wz, u1..u4): body twist in the body frame and the
+four hinge opening rates. Equations: 3 force/torque balances on the whole robot and 4
+torque balances at the hinges (medium + spring [+ damping]); a hinge resting on a stop
+with the net torque pushing into it is held (u = 0, the stop takes the torque), which is
+decided by a small active-set loop. Solved by damped Newton with an analytic Jacobian,
+warm-started from the previous step; continuation on the smoothing scale only when
+Newton fails.
+
+Layout of the per-trial parameter vector `prm` (indices P_*):
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+P_CS, P_CF, P_CL, P_GAMMA, P_EPS, P_MU = 0, 1, 2, 3, 4, 5
+P_ASYM, P_NORMAL, P_COMPACT = 6, 7, 8
+P_K, P_PRELOAD, P_AMAX, P_CHINGE = 9, 10, 11, 12
+P_FLMODE, P_FLLOCK, P_TAU = 13, 14, 15
+P_TOL, P_MAXIT, P_SFLOOR, P_LREF, P_SUBSTEPS = 16, 17, 18, 19, 20
+N_PARAMS = 21
+
+FL_FREE, FL_LOCKED, FL_ABSENT = 0, 1, 2
+N_UNKNOWN = 7
+# Newton step caps in scaled units (velocity / (L_ref * shape rate), hinge rate / shape rate)
+STEP_BODY = 0.1
+STEP_HINGE = 1.0
+
+
+@njit(cache=True)
+def _element_geometry(
+    phi1, phi2, dphi1, dphi2, ang, el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side, geo
+):
+    """Positions, axes, hinge columns and shape-driven velocities of all elements.
+
+    geo: array (n_el, 9) filled with px, py, tx, ty, bx, by, cx, cy, hinge index
+    (body frame, units of L_ref; b = velocity per unit hinge rate, c = velocity from
+    the shape rate).
+    """
+    c1, s1 = math.cos(phi1), math.sin(phi1)
+    c2, s2 = math.cos(-phi2), math.sin(-phi2)
+    for e in range(el_part.shape[0]):
+        part = el_part[e]
+        s = el_s[e]
+        hidx = -1
+        if part < 3:
+            seg = part
+            sx, sy = s, 0.0
+            ax, ay = 1.0, 0.0
+        else:
+            hidx = part - 3
+            seg = fl_seg[hidx]
+            side = fl_side[hidx]
+            a = ang[hidx]
+            dx, dy = -math.cos(a), side * math.sin(a)
+            sx = fl_hx[hidx] + s * dx
+            sy = fl_hy[hidx] + s * dy
+            ax, ay = dx, dy
+        if seg == 0:
+            ox, cs, sn, rate = half_mid, c1, s1, dphi1
+        elif seg == 2:
+            ox, cs, sn, rate = -half_mid, c2, s2, -dphi2
+        else:
+            ox, cs, sn, rate = 0.0, 1.0, 0.0, 0.0
+        rx = cs * sx - sn * sy
+        ry = sn * sx + cs * sy
+        px = ox + rx
+        py = ry
+        geo[e, 0] = px
+        geo[e, 1] = py
+        geo[e, 2] = cs * ax - sn * ay
+        geo[e, 3] = sn * ax + cs * ay
+        # segment rotation about its joint at `rate` (rad/s per unit shape rate)
+        geo[e, 6] = -rate * ry
+        geo[e, 7] = rate * rx
+        if hidx >= 0:
+            hx = ox + cs * fl_hx[hidx] - sn * fl_hy[hidx]
+            hy = sn * fl_hx[hidx] + cs * fl_hy[hidx]
+            # flipper turns at -side * u relative to its segment (opening is outwards)
+            w = -fl_side[hidx]
+            geo[e, 4] = -w * (py - hy)
+            geo[e, 5] = w * (px - hx)
+        else:
+            geo[e, 4] = 0.0
+            geo[e, 5] = 0.0
+        geo[e, 8] = hidx
+
+
+@njit(cache=True)
+def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, want_j, qh):
+    """Residual R(x) (7,) and, if want_j, Jacobian J (7, 7); qh (4,) gets the hinge
+    generalised torque at the current x (used to release a held hinge)."""
+    cs = prm[P_CS] * normal_fac
+    cf = prm[P_CF]
+    cl = prm[P_CL]
+    gam = prm[P_GAMMA]
+    mu = prm[P_MU]
+    rho = prm[P_ASYM]
+    e2 = eps * eps
+    for i in range(N_UNKNOWN):
+        R[i] = 0.0
+        if want_j:
+            for j in range(N_UNKNOWN):
+                J[i, j] = 0.0
+    for i in range(4):
+        qh[i] = 0.0
+    for e in range(el_part.shape[0]):
+        w = el_w[e]
+        if w == 0.0:
+            continue
+        px = geo[e, 0]
+        py = geo[e, 1]
+        tx = geo[e, 2]
+        ty = geo[e, 3]
+        nx = -ty
+        ny = tx
+        h = int(geo[e, 8])
+        uh = 0.0
+        if h >= 0:
+            uh = x[3 + h]
+        vx = x[0] - x[2] * py + geo[e, 4] * uh + geo[e, 6]
+        vy = x[1] + x[2] * px + geo[e, 5] * uh + geo[e, 7]
+        vp = vx * tx + vy * ty
+        vn = vx * nx + vy * ny
+        V2 = vp * vp + vn * vn + e2
+        V = math.sqrt(V2)
+        V3 = V2 * V
+        Ru = math.sqrt(vp * vp + e2)
+        Rw = math.sqrt(vn * vn + e2)
+        p1 = vp / V
+        g = vp / Ru
+        sn = Rw / V
+        p2 = g * (1.0 - sn)
+        q = vn / V
+        gq = math.sqrt(1.0 + gam * gam * q * q)
+        hq = gam * q / gq
+        if el_part[e] < 3:
+            m = 0.5 * (1.0 + rho) - 0.5 * (rho - 1.0) * g
+        else:
+            m = 1.0
+        fpar = -w * ((cf * p1 + cl * p2) * m + mu * vp)
+        fper = -w * (cs * hq + mu * vn)
+        fx = fpar * tx + fper * nx
+        fy = fpar * ty + fper * ny
+        R[0] += fx
+        R[1] += fy
+        R[2] += px * fy - py * fx
+        if h >= 0:
+            qq = geo[e, 4] * fx + geo[e, 5] * fy
+            R[3 + h] += qq
+            qh[h] += qq
+        if want_j:
+            dp1_p = (vn * vn + e2) / V3
+            dp1_n = -vp * vn / V3
+            dg_p = e2 / (Ru * Ru * Ru)
+            dsn_p = -Rw * vp / V3
+            dsn_n = vn / (Rw * V) - Rw * vn / V3
+            dp2_p = dg_p * (1.0 - sn) - g * dsn_p
+            dp2_n = -g * dsn_n
+            dq_p = -vn * vp / V3
+            dq_n = (vp * vp + e2) / V3
+            dh = gam / (gq * gq * gq)
+            dm_p = 0.0
+            if el_part[e] < 3:
+                dm_p = -0.5 * (rho - 1.0) * dg_p
+            a11 = -w * ((cf * dp1_p + cl * dp2_p) * m + (cf * p1 + cl * p2) * dm_p + mu)
+            a12 = -w * (cf * dp1_n + cl * dp2_n) * m
+            a21 = -w * cs * dh * dq_p
+            a22 = -w * (cs * dh * dq_n + mu)
+            # body-frame 2x2: M D M^T with M = [t n]
+            b11 = tx * (a11 * tx + a12 * nx) + nx * (a21 * tx + a22 * nx)
+            b12 = tx * (a11 * ty + a12 * ny) + nx * (a21 * ty + a22 * ny)
+            b21 = ty * (a11 * tx + a12 * nx) + ny * (a21 * tx + a22 * nx)
+            b22 = ty * (a11 * ty + a12 * ny) + ny * (a21 * ty + a22 * ny)
+            # element velocity Jacobian rows over columns (0, 1, 2, 3+h)
+            bx2 = -py
+            by2 = px
+            bxh = geo[e, 4]
+            byh = geo[e, 5]
+            # dF/dx = D B  (2 x 4)
+            d0x, d0y = b11, b21
+            d1x, d1y = b12, b22
+            d2x = b11 * bx2 + b12 * by2
+            d2y = b21 * bx2 + b22 * by2
+            dhx = b11 * bxh + b12 * byh
+            dhy = b21 * bxh + b22 * byh
+            # rows: B^T (dF/dx); row 2 is the torque px*fy - py*fx
+            J[0, 0] += d0x
+            J[0, 1] += d1x
+            J[0, 2] += d2x
+            J[1, 0] += d0y
+            J[1, 1] += d1y
+            J[1, 2] += d2y
+            J[2, 0] += px * d0y - py * d0x
+            J[2, 1] += px * d1y - py * d1x
+            J[2, 2] += px * d2y - py * d2x
+            if h >= 0:
+                c = 3 + h
+                J[0, c] += dhx
+                J[1, c] += dhy
+                J[2, c] += px * dhy - py * dhx
+                J[c, 0] += bxh * d0x + byh * d0y
+                J[c, 1] += bxh * d1x + byh * d1y
+                J[c, 2] += bxh * d2x + byh * d2y
+                J[c, c] += bxh * dhx + byh * dhy
+    k = prm[P_K]
+    pre = prm[P_PRELOAD]
+    for i in range(4):
+        c = 3 + i
+        if held[i]:
+            qh[i] += -k * (ang[i] + pre)
+            R[c] = x[c]
+            if want_j:
+                for j in range(N_UNKNOWN):
+                    J[c, j] = 0.0
+                J[c, c] = 1.0
+        else:
+            spring = -k * (ang[i] + pre) - c_hinge * x[c]
+            R[c] += spring
+            qh[i] += spring
+            if want_j:
+                J[c, c] += -c_hinge
+
+
+@njit(cache=True)
+def _lin_solve(A, b, out):
+    """Solve A out = b (7x7) by Gaussian elimination with partial pivoting; False if singular."""
+    n = b.shape[0]
+    M = A.copy()
+    r = b.copy()
+    for col in range(n):
+        piv = col
+        best = abs(M[col, col])
+        for i in range(col + 1, n):
+            if abs(M[i, col]) > best:
+                best = abs(M[i, col])
+                piv = i
+        if best < 1e-300:
+            return False
+        if piv != col:
+            for j in range(n):
+                tmp = M[col, j]
+                M[col, j] = M[piv, j]
+                M[piv, j] = tmp
+            tmp = r[col]
+            r[col] = r[piv]
+            r[piv] = tmp
+        inv = 1.0 / M[col, col]
+        for i in range(col + 1, n):
+            f = M[i, col] * inv
+            if f != 0.0:
+                for j in range(col, n):
+                    M[i, j] -= f * M[col, j]
+                r[i] -= f * r[col]
+    for i in range(n - 1, -1, -1):
+        acc = r[i]
+        for j in range(i + 1, n):
+            acc -= M[i, j] * out[j]
+        out[i] = acc / M[i, i]
+    return True
+
+
+@njit(cache=True)
+def _norm(v):
+    acc = 0.0
+    for i in range(v.shape[0]):
+        acc += v[i] * v[i]
+    return math.sqrt(acc)
+
+
+@njit(cache=True)
+def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, max_iter, work):
+    """Damped Newton from x (modified in place). Returns (residual norm, iterations).
+
+    Trial points are assembled with their Jacobian, so an accepted full step costs one
+    assembly."""
+    R = work[0]
+    Rt = work[1]
+    dx = work[2]
+    xt = work[3]
+    qh = work[4]
+    J = np.empty((N_UNKNOWN, N_UNKNOWN))
+    Jt = np.empty((N_UNKNOWN, N_UNKNOWN))
+    _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+    nr = _norm(R)
+    it = 0
+    while nr > tol and it < max_iter:
+        it += 1
+        for i in range(N_UNKNOWN):
+            Rt[i] = -R[i]
+        if not _lin_solve(J, Rt, dx):
+            return nr, it
+        # trust region: the saturating law makes full Newton steps from the far side of
+        # a stick transition land far away, so cap the step (scaled units)
+        ratio = 0.0
+        for i in range(N_UNKNOWN):
+            lim = STEP_BODY if i < 3 else STEP_HINGE
+            ratio = max(ratio, abs(dx[i]) / lim)
+        if ratio > 1.0:
+            for i in range(N_UNKNOWN):
+                dx[i] /= ratio
+        t = 1.0
+        accepted = False
+        while t > 1e-3:
+            for i in range(N_UNKNOWN):
+                xt[i] = x[i] + t * dx[i]
+            _assemble(
+                xt,
+                geo,
+                el_w,
+                el_part,
+                prm,
+                eps,
+                normal_fac,
+                held,
+                ang,
+                c_hinge,
+                Rt,
+                Jt,
+                t == 1.0,
+                qh,
+            )
+            nt = _norm(Rt)
+            if nt <= (1.0 - 1e-4 * t) * nr:
+                accepted = True
+                break
+            t *= 0.25
+        if not accepted:
+            # stalled at a kink of the smoothed law: the caller continues on eps
+            _assemble(
+                x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh
+            )
+            return nr, it
+        for i in range(N_UNKNOWN):
+            x[i] = xt[i]
+        if t == 1.0:
+            for i in range(N_UNKNOWN):
+                R[i] = Rt[i]
+                for j in range(N_UNKNOWN):
+                    J[i, j] = Jt[i, j]
+        else:
+            _assemble(
+                x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh
+            )
+        nr = _norm(R)
+    return nr, it
+
+
+@njit(cache=True)
+def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, max_iter, work):
+    """Levenberg-Marquardt on |R|^2 from x (in place): slower than Newton but does not
+    stall on the plateaus of the saturating law. Returns (residual norm, iterations)."""
+    R = work[0]
+    Rt = work[1]
+    dx = work[2]
+    xt = work[3]
+    qh = work[4]
+    J = np.empty((N_UNKNOWN, N_UNKNOWN))
+    Jd = np.empty((N_UNKNOWN, N_UNKNOWN))
+    A = np.empty((N_UNKNOWN, N_UNKNOWN))
+    g = np.empty(N_UNKNOWN)
+    _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+    nr = _norm(R)
+    lam = 1e-6
+    it = 0
+    while nr > tol and it < max_iter:
+        it += 1
+        for i in range(N_UNKNOWN):
+            acc = 0.0
+            for k in range(N_UNKNOWN):
+                acc += J[k, i] * R[k]
+            g[i] = -acc
+            for j in range(N_UNKNOWN):
+                acc = 0.0
+                for k in range(N_UNKNOWN):
+                    acc += J[k, i] * J[k, j]
+                A[i, j] = acc
+        improved = False
+        while lam < 1e12:
+            for i in range(N_UNKNOWN):
+                for j in range(N_UNKNOWN):
+                    Jd[i, j] = A[i, j]
+                Jd[i, i] += lam * (A[i, i] + 1e-12)
+            if _lin_solve(Jd, g, dx):
+                for i in range(N_UNKNOWN):
+                    xt[i] = x[i] + dx[i]
+                _assemble(
+                    xt,
+                    geo,
+                    el_w,
+                    el_part,
+                    prm,
+                    eps,
+                    normal_fac,
+                    held,
+                    ang,
+                    c_hinge,
+                    Rt,
+                    J,
+                    False,
+                    qh,
+                )
+                nt = _norm(Rt)
+                if nt < nr:
+                    improved = True
+                    break
+            lam *= 4.0
+        if not improved:
+            break
+        lam = max(lam / 5.0, 1e-9)
+        for i in range(N_UNKNOWN):
+            x[i] = xt[i]
+        _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+        nr = _norm(R)
+    return nr, it
+
+
+@njit(cache=True)
+def _solve_step(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge, work):
+    """Quasi-static solve at unit shape rate: Newton, then continuation if it fails.
+
+    Returns (residual norm, newton iterations, used_continuation)."""
+    eps = prm[P_EPS]
+    tol = prm[P_TOL]
+    max_iter = int(prm[P_MAXIT])
+    x0 = work[5]
+    for i in range(N_UNKNOWN):
+        x0[i] = x[i]
+    nr, it = _newton(
+        x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, max_iter, work
+    )
+    if nr <= tol:
+        return nr, it, False
+    total = it
+    nr, it = _lm(
+        x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, 4 * max_iter, work
+    )
+    total += it
+    if nr <= tol:
+        return nr, total, True
+    # continuation on the smoothing scale: solve a smoother problem first, from the
+    # warm start and, if that fails too, from rest
+    for attempt in range(2):
+        for i in range(N_UNKNOWN):
+            x[i] = x0[i] if attempt == 0 else 0.0
+        mult = 1000.0
+        while mult > 0.9:
+            nr, it = _newton(
+                x,
+                geo,
+                el_w,
+                el_part,
+                prm,
+                eps * mult,
+                normal_fac,
+                held,
+                ang,
+                c_hinge,
+                tol,
+                max_iter,
+                work,
+            )
+            total += it
+            if nr > tol:
+                nr, it = _lm(
+                    x,
+                    geo,
+                    el_w,
+                    el_part,
+                    prm,
+                    eps * mult,
+                    normal_fac,
+                    held,
+                    ang,
+                    c_hinge,
+                    tol,
+                    4 * max_iter,
+                    work,
+                )
+                total += it
+            mult /= 3.1622776601683795
+        if nr <= tol:
+            break
+    return nr, total, True
+
+
+@njit(cache=True)
+def _solve_with_stops(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge, work):
+    """Solve, then hold hinges pushing into a stop and release held ones pulled away."""
+    amax = prm[P_AMAX]
+    mode = int(prm[P_FLMODE])
+    qh = work[4]
+    nr, it, cont = 0.0, 0, False
+    for _ in range(6):
+        nr, i2, c2 = _solve_step(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge, work)
+        it += i2
+        cont = cont or c2
+        if mode != FL_FREE:
+            break
+        changed = False
+        for i in range(4):
+            at_closed = ang[i] <= 1e-9
+            at_open = ang[i] >= amax - 1e-9
+            if held[i]:
+                # qh = generalised torque on the held hinge; the stop can only push
+                if (
+                    (at_closed and qh[i] > 0.0)
+                    or (at_open and qh[i] < 0.0)
+                    or not (at_closed or at_open)
+                ):
+                    held[i] = False
+                    changed = True
+            else:
+                u = x[3 + i]
+                if (at_closed and u < 0.0) or (at_open and u > 0.0):
+                    held[i] = True
+                    x[3 + i] = 0.0
+                    changed = True
+        if not changed:
+            break
+    return nr, it, cont
+
+
+@njit(cache=True)
+def run_trials(
+    phi,
+    n_steps,
+    pose0,
+    ang0,
+    prm,
+    el_part,
+    el_s,
+    el_w,
+    half_mid,
+    fl_seg,
+    fl_hx,
+    fl_hy,
+    fl_side,
+    dt,
+    pose,
+    vel,
+    ang_out,
+    resid,
+    iters,
+    n_cont,
+):
+    """Integrate prescribed joint trajectories for a batch of trials.
+
+    phi: (n_trials, n_frames, 2) rad, sampled every dt s; n_steps[k] frames used by
+    trial k. pose0 (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials,
+    N_PARAMS). Outputs (filled): pose (n_trials, n_frames, 3) world x, y (mm), theta;
+    vel (n_trials, n_frames, 3) body twist vx, vy (mm/s), wz (rad/s), centred on the
+    frames; ang_out (n_trials, n_frames, 4); resid (n_trials, n_frames) max scaled
+    residual of the solves ending at each frame; iters, n_cont (n_trials,) totals.
+    """
+    n_trials = phi.shape[0]
+    n_el = el_part.shape[0]
+    geo = np.empty((n_el, 9))
+    work = np.zeros((6, N_UNKNOWN))
+    x = np.zeros(N_UNKNOWN)
+    xlast = np.zeros(N_UNKNOWN)
+    held = np.zeros(4, dtype=np.bool_)
+    ang = np.zeros(4)
+    amid = np.zeros(4)
+    uprev = np.zeros(4)
+    w_eff = np.empty(n_el)
+    for k in range(n_trials):
+        p = prm[k]
+        lref = p[P_LREF]
+        amax = p[P_AMAX]
+        mode = int(p[P_FLMODE])
+        nsub = int(p[P_SUBSTEPS])
+        tau = p[P_TAU]
+        h = dt / nsub
+        relax = 1.0 if tau <= 0.0 else 1.0 - math.exp(-h / tau)
+        for e in range(n_el):
+            w_eff[e] = el_w[e]
+            if el_part[e] >= 3 and mode == FL_ABSENT:
+                w_eff[e] = 0.0
+        X, Y, TH = pose0[k, 0], pose0[k, 1], pose0[k, 2]
+        for i in range(4):
+            if mode == FL_FREE:
+                ang[i] = min(max(ang0[k, i], 0.0), amax)
+            else:
+                ang[i] = p[P_FLLOCK]
+            held[i] = mode != FL_FREE or ang[i] <= 1e-9 or ang[i] >= amax - 1e-9
+            uprev[i] = 0.0
+        for i in range(N_UNKNOWN):
+            x[i] = 0.0
+            xlast[i] = 0.0
+        v_prev0, v_prev1, v_prev2 = 0.0, 0.0, 0.0
+        dist = 0.0
+        iters[k] = 0
+        n_cont[k] = 0
+        nf = n_steps[k]
+        pose[k, 0, 0] = X
+        pose[k, 0, 1] = Y
+        pose[k, 0, 2] = TH
+        for i in range(4):
+            ang_out[k, 0, i] = ang[i]
+        resid[k, 0] = 0.0
+        last0, last1, last2 = 0.0, 0.0, 0.0
+        for f in range(nf - 1):
+            sum0, sum1, sum2 = 0.0, 0.0, 0.0
+            rmax = 0.0
+            for sub in range(nsub):
+                fa = sub / nsub
+                fb = (sub + 1) / nsub
+                a1 = phi[k, f, 0] + fa * (phi[k, f + 1, 0] - phi[k, f, 0])
+                a2 = phi[k, f, 1] + fa * (phi[k, f + 1, 1] - phi[k, f, 1])
+                b1 = phi[k, f, 0] + fb * (phi[k, f + 1, 0] - phi[k, f, 0])
+                b2 = phi[k, f, 1] + fb * (phi[k, f + 1, 1] - phi[k, f, 1])
+                d1 = (b1 - a1) / h
+                d2 = (b2 - a2) / h
+                s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
+                for i in range(4):
+                    amid[i] = min(max(ang[i] + 0.5 * h * uprev[i], 0.0), amax)
+                    if mode != FL_FREE:
+                        amid[i] = ang[i]
+                    if held[i] and mode == FL_FREE:
+                        amid[i] = ang[i]
+                _element_geometry(
+                    0.5 * (a1 + b1),
+                    0.5 * (a2 + b2),
+                    d1 / s,
+                    d2 / s,
+                    amid,
+                    el_part,
+                    el_s,
+                    half_mid,
+                    fl_seg,
+                    fl_hx,
+                    fl_hy,
+                    fl_side,
+                    geo,
+                )
+                # linear predictor of the body twist from the last two solves
+                for i in range(3):
+                    xo = x[i]
+                    x[i] = 2.0 * x[i] - xlast[i]
+                    xlast[i] = xo
+                normal_fac = p[P_NORMAL] * (1.0 + p[P_COMPACT] * dist)
+                c_hinge = p[P_CHINGE] * s
+                nr, it, cont = _solve_with_stops(
+                    x, geo, w_eff, el_part, p, normal_fac, held, amid, c_hinge, work
+                )
+                iters[k] += it
+                if cont:
+                    n_cont[k] += 1
+                if nr > rmax:
+                    rmax = nr
+                qs0 = x[0] * s * lref
+                qs1 = x[1] * s * lref
+                qs2 = x[2] * s
+                v_prev0 += relax * (qs0 - v_prev0)
+                v_prev1 += relax * (qs1 - v_prev1)
+                v_prev2 += relax * (qs2 - v_prev2)
+                # SE(2) exponential of the body twist over h
+                wx = v_prev0 * h
+                wy = v_prev1 * h
+                wt = v_prev2 * h
+                if abs(wt) > 1e-9:
+                    sa = math.sin(wt) / wt
+                    ca = (1.0 - math.cos(wt)) / wt
+                else:
+                    sa = 1.0 - wt * wt / 6.0
+                    ca = 0.5 * wt
+                lx = sa * wx - ca * wy
+                ly = ca * wx + sa * wy
+                cth = math.cos(TH)
+                sth = math.sin(TH)
+                X += cth * lx - sth * ly
+                Y += sth * lx + cth * ly
+                TH += wt
+                dist += math.sqrt(wx * wx + wy * wy) / lref
+                for i in range(4):
+                    if mode == FL_FREE:
+                        u = x[3 + i] * s
+                        if held[i]:
+                            u = 0.0
+                        ang[i] = min(max(ang[i] + h * u, 0.0), amax)
+                        uprev[i] = u
+                        held[i] = held[i] and (ang[i] <= 1e-9 or ang[i] >= amax - 1e-9)
+                sum0 += v_prev0
+                sum1 += v_prev1
+                sum2 += v_prev2
+            m0, m1, m2 = sum0 / nsub, sum1 / nsub, sum2 / nsub
+            if f == 0:
+                vel[k, 0, 0] = m0
+                vel[k, 0, 1] = m1
+                vel[k, 0, 2] = m2
+            else:
+                vel[k, f, 0] = 0.5 * (last0 + m0)
+                vel[k, f, 1] = 0.5 * (last1 + m1)
+                vel[k, f, 2] = 0.5 * (last2 + m2)
+            last0, last1, last2 = m0, m1, m2
+            pose[k, f + 1, 0] = X
+            pose[k, f + 1, 1] = Y
+            pose[k, f + 1, 2] = TH
+            for i in range(4):
+                ang_out[k, f + 1, i] = ang[i]
+            resid[k, f + 1] = rmax
+        if nf >= 2:
+            vel[k, nf - 1, 0] = last0
+            vel[k, nf - 1, 1] = last1
+            vel[k, nf - 1, 2] = last2
+        elif nf == 1:
+            vel[k, 0, 0] = 0.0
+            vel[k, 0, 1] = 0.0
+            vel[k, 0, 2] = 0.0
+
+
+@njit(cache=True)
+def solve_twists(
+    phis, dphis, prm, el_part, el_s, el_w, half_mid, fl_seg, fl_hx, fl_hy, fl_side, out, res
+):
+    """Quasi-static body twists at fixed shapes with flippers held (local connection).
+
+    phis (n, 2) rad, dphis (n, 2) rad/s; out (n, 3) gets vx, vy (mm/s), wz (rad/s);
+    res (n,) the scaled residual. Each solve starts from rest with continuation on the
+    smoothing scale (no warm start), so results do not depend on the order of points.
+    """
+    n_el = el_part.shape[0]
+    geo = np.empty((n_el, 9))
+    work = np.zeros((6, N_UNKNOWN))
+    x = np.zeros(N_UNKNOWN)
+    held = np.ones(4, dtype=np.bool_)
+    ang = np.zeros(4)
+    lref = prm[P_LREF]
+    w_eff = el_w.copy()
+    mode = int(prm[P_FLMODE])
+    for e in range(n_el):
+        if el_part[e] >= 3 and mode == FL_ABSENT:
+            w_eff[e] = 0.0
+    for i in range(4):
+        ang[i] = prm[P_FLLOCK]
+    eps = prm[P_EPS]
+    tol = prm[P_TOL]
+    max_iter = int(prm[P_MAXIT])
+    for n in range(phis.shape[0]):
+        d1, d2 = dphis[n, 0], dphis[n, 1]
+        s = math.sqrt(d1 * d1 + d2 * d2 + prm[P_SFLOOR] * prm[P_SFLOOR])
+        _element_geometry(
+            phis[n, 0],
+            phis[n, 1],
+            d1 / s,
+            d2 / s,
+            ang,
+            el_part,
+            el_s,
+            half_mid,
+            fl_seg,
+            fl_hx,
+            fl_hy,
+            fl_side,
+            geo,
+        )
+        for i in range(N_UNKNOWN):
+            x[i] = 0.0
+        nr = 0.0
+        mult = 1000.0
+        while mult >= 1.0:
+            nr, _ = _newton(
+                x,
+                geo,
+                w_eff,
+                el_part,
+                prm,
+                eps * mult,
+                prm[P_NORMAL],
+                held,
+                ang,
+                0.0,
+                tol,
+                max_iter,
+                work,
+            )
+            mult *= 0.1
+        out[n, 0] = x[0] * s * lref
+        out[n, 1] = x[1] * s * lref
+        out[n, 2] = x[2] * s
+        res[n] = nr
