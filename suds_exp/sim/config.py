@@ -26,9 +26,12 @@ from typing import Any
 from suds_exp.errors import ConfigError
 
 
-def _p(unit: str, low: Any, high: Any, doc: str, main: bool = False, on: Any = None) -> dict:
-    """Field metadata of an effect parameter (unit, realistic range, meaning)."""
-    return {"unit": unit, "range": (low, high), "doc": doc, "main": main, "on": on}
+def _p(
+    unit: str, low: Any, high: Any, doc: str, main: bool = False, on: Any = None, off: Any = None
+) -> dict:
+    """Field metadata of an effect parameter: unit, realistic range, meaning; for the
+    main parameter also its typical "on" value and its "off" value (no effect)."""
+    return {"unit": unit, "range": (low, high), "doc": doc, "main": main, "on": on, "off": off}
 
 
 @dataclass
@@ -137,9 +140,14 @@ class Solver:
 
 @dataclass
 class FlippersEffect:
+    """Passive flippers: free on their spring hinges, locked at a fixed opening, or
+    removed. Locking removes the passive shape and the flippers' ratchet-like thrust."""
+
     mode: str = field(
         default="free",
-        metadata=_p("-", "free", "absent", "free | locked | absent", main=True, on="locked"),
+        metadata=_p(
+            "-", "free", "absent", "free | locked | absent", main=True, on="locked", off="free"
+        ),
     )
     locked_angle_deg: float = field(
         default=0.0, metadata=_p("deg", 0.0, 80.0, "opening of locked flippers")
@@ -148,47 +156,70 @@ class FlippersEffect:
 
 @dataclass
 class HingeDampingEffect:
+    """Viscous friction in the tape hinges: flippers lag behind, more at high frequency."""
+
     damping: float = field(
         default=0.0,
-        metadata=_p("N mm s/rad", 0.0, 30.0, "viscous torque per hinge rate", main=True, on=8.0),
+        metadata=_p(
+            "N mm s/rad", 0.0, 200.0, "viscous torque per hinge rate", main=True, on=50.0, off=0.0
+        ),
     )
 
 
 @dataclass
 class BodyInertiaEffect:
+    """Momentum: the body twist relaxes towards the quasi-static one with time constant
+    tau, so motion lags the shape and shrinks at high frequency (speed dependence)."""
+
     tau_s: float = field(
         default=0.0,
         metadata=_p(
-            "s", 0.0, 0.5, "body velocity relaxes to the quasi-static one", main=True, on=0.15
+            "s",
+            0.0,
+            0.5,
+            "body velocity relaxes to the quasi-static one",
+            main=True,
+            on=0.15,
+            off=0.0,
         ),
     )
 
 
 @dataclass
 class AsymmetricDragEffect:
+    """Tangential drag on the segments differs sliding forward (towards the head) vs
+    backward (grain texture, surface finish): slows or speeds the forward glide."""
+
     ratio: float = field(
         default=1.0,
         metadata=_p(
             "-",
             0.5,
             2.5,
-            "tangential drag backward / forward on the segments",
+            "tangential drag on the segments sliding forward / backward",
             main=True,
             on=1.8,
+            off=1.0,
         ),
     )
 
 
 @dataclass
 class DragAnisotropyEffect:
+    """Normal vs tangential drag ratio differs from glass beads (beans are not beads):
+    scales all propulsion and the lateral slip."""
+
     normal_scale: float = field(
         default=1.0,
-        metadata=_p("-", 0.5, 2.0, "multiplies the normal drag C_S", main=True, on=1.5),
+        metadata=_p("-", 0.5, 2.0, "multiplies the normal drag C_S", main=True, on=1.5, off=1.0),
     )
 
 
 @dataclass
 class MediumCompactionEffect:
+    """The bed compacts as the robot ploughs through it: normal drag grows with distance
+    travelled, so speed drifts along a trial."""
+
     rate_per_m: float = field(
         default=0.0,
         metadata=_p(
@@ -198,12 +229,16 @@ class MediumCompactionEffect:
             "normal drag grows by this fraction per metre travelled",
             main=True,
             on=1.5,
+            off=0.0,
         ),
     )
 
 
 @dataclass
 class SpokeOscillationEffect:
+    """Raised spoke markers ring on their skewers (damped oscillation driven by the
+    spoke base's acceleration); affects the measured markers, not the body."""
+
     gain: float = field(
         default=1.0,
         metadata=_p(
@@ -213,6 +248,7 @@ class SpokeOscillationEffect:
             "spoke marker response to base acceleration (1 = rigid mass on spring)",
             main=True,
             on=1.0,
+            off=0.0,
         ),
     )
     freq_hz: float = field(

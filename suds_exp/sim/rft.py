@@ -148,7 +148,8 @@ def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R
         gq = math.sqrt(1.0 + gam * gam * q * q)
         hq = gam * q / gq
         if el_part[e] < 3:
-            m = 0.5 * (1.0 + rho) - 0.5 * (rho - 1.0) * g
+            # rho when sliding forward (towards the head), 1 when sliding backward
+            m = 0.5 * (1.0 + rho) + 0.5 * (rho - 1.0) * g
         else:
             m = 1.0
         fpar = -w * ((cf * p1 + cl * p2) * m + mu * vp)
@@ -175,7 +176,7 @@ def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R
             dh = gam / (gq * gq * gq)
             dm_p = 0.0
             if el_part[e] < 3:
-                dm_p = -0.5 * (rho - 1.0) * dg_p
+                dm_p = 0.5 * (rho - 1.0) * dg_p
             a11 = -w * ((cf * dp1_p + cl * dp2_p) * m + (cf * p1 + cl * p2) * dm_p + mu)
             a12 = -w * (cf * dp1_n + cl * dp2_n) * m
             a21 = -w * cs * dh * dq_p
@@ -730,8 +731,8 @@ def solve_twists(
     """Quasi-static body twists at fixed shapes with flippers held (local connection).
 
     phis (n, 2) rad, dphis (n, 2) rad/s; out (n, 3) gets vx, vy (mm/s), wz (rad/s);
-    res (n,) the scaled residual. Each solve starts from rest with continuation on the
-    smoothing scale (no warm start), so results do not depend on the order of points.
+    res (n,) the scaled residual. Each solve starts from rest (no warm start), so results
+    do not depend on the order of points.
     """
     n_el = el_part.shape[0]
     geo = np.empty((n_el, 9))
@@ -747,9 +748,6 @@ def solve_twists(
             w_eff[e] = 0.0
     for i in range(4):
         ang[i] = prm[P_FLLOCK]
-    eps = prm[P_EPS]
-    tol = prm[P_TOL]
-    max_iter = int(prm[P_MAXIT])
     for n in range(phis.shape[0]):
         d1, d2 = dphis[n, 0], dphis[n, 1]
         s = math.sqrt(d1 * d1 + d2 * d2 + prm[P_SFLOOR] * prm[P_SFLOOR])
@@ -770,25 +768,7 @@ def solve_twists(
         )
         for i in range(N_UNKNOWN):
             x[i] = 0.0
-        nr = 0.0
-        mult = 1000.0
-        while mult >= 1.0:
-            nr, _ = _newton(
-                x,
-                geo,
-                w_eff,
-                el_part,
-                prm,
-                eps * mult,
-                prm[P_NORMAL],
-                held,
-                ang,
-                0.0,
-                tol,
-                max_iter,
-                work,
-            )
-            mult *= 0.1
+        nr, _, _ = _solve_step(x, geo, w_eff, el_part, prm, prm[P_NORMAL], held, ang, 0.0, work)
         out[n, 0] = x[0] * s * lref
         out[n, 1] = x[1] * s * lref
         out[n, 2] = x[2] * s

@@ -1,0 +1,117 @@
+"""The named candidate effects as data, and setting them on a configuration.
+
+`effect_library()` lists every effect with its parameters (unit, nominal value, realistic
+range, meaning), its main parameter and that parameter's "on" and "off" values; the
+discrepancy workflow fits effects within these ranges and `suds-exp effects` prints it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+
+from suds_exp.errors import ConfigError
+from suds_exp.sim.config import Effects, SimConfig, config_from_dict
+
+EFFECT_NAMES = tuple(f.name for f in dataclasses.fields(Effects))
+
+
+def _effect_class(name: str):
+    for f in dataclasses.fields(Effects):
+        if f.name == name:
+            return f.default_factory
+    raise ConfigError(f"effect {name!r}: expected one of {', '.join(EFFECT_NAMES)}")
+
+
+def _main_field(name: str) -> dataclasses.Field:
+    return next(f for f in dataclasses.fields(_effect_class(name)) if f.metadata.get("main"))
+
+
+def effect_library(config: SimConfig | None = None) -> list[dict]:
+    """Every named effect as a dict (JSON-ready).
+
+    Keys: ``name``, ``description``, ``main`` (main parameter name), ``on_value``,
+    ``off_value``, ``nominal_state`` ("on"/"off", or the mode for ``flippers``),
+    ``state`` (the same for `config`, default nominal) and ``parameters``: list of
+    {``name``, ``unit``, ``nominal``, ``value`` (in `config`), ``range`` [low, high],
+    ``description``, ``config_key`` (dotted path in the config file)}.
+    """
+    nominal = Effects()
+    current = (config or SimConfig()).effects
+    out = []
+    for name in EFFECT_NAMES:
+        cls = _effect_class(name)
+        main = _main_field(name)
+        params = []
+        for f in dataclasses.fields(cls):
+            md = f.metadata
+            params.append(
+                {
+                    "name": f.name,
+                    "unit": md["unit"],
+                    "nominal": getattr(getattr(nominal, name), f.name),
+                    "value": getattr(getattr(current, name), f.name),
+                    "range": list(md["range"]),
+                    "description": md["doc"],
+                    "config_key": f"effects.{name}.{f.name}",
+                }
+            )
+        off = main.metadata["off"]
+
+        def state(effects: Effects, name=name, main=main, off=off) -> str:
+            value = getattr(getattr(effects, name), main.name)
+            if isinstance(value, str):
+                return value
+            return "off" if value == off else "on"
+
+        out.append(
+            {
+                "name": name,
+                "description": inspect.cleandoc(cls.__doc__ or ""),
+                "main": main.name,
+                "on_value": main.metadata["on"],
+                "off_value": off,
+                "nominal_state": state(nominal),
+                "state": state(current),
+                "parameters": params,
+            }
+        )
+    return out
+
+
+def set_effect(config: SimConfig, assignment: str) -> SimConfig:
+    """A copy of `config` with one effect set from ``NAME=VALUE`` or ``NAME.PARAM=VALUE``.
+
+    VALUE is a number, ``on`` / ``off`` (the main parameter's typical on value / its
+    no-effect value) or, for ``flippers``, ``free`` / ``locked`` / ``absent``.
+    """
+    if "=" not in assignment:
+        raise ConfigError(f"--effect {assignment!r}: expected NAME=VALUE, e.g. hinge_damping=5")
+    key, text = (s.strip() for s in assignment.split("=", 1))
+    name, _, param = key.partition(".")
+    cls = _effect_class(name)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    field = _main_field(name) if not param else fields.get(param)
+    if field is None:
+        raise ConfigError(f"--effect {assignment!r}: {name} has parameters {', '.join(fields)}")
+    md = field.metadata
+    if text in ("on", "off") and md.get("main"):
+        value = md[text]
+    elif isinstance(field.default, str):
+        value = text
+    else:
+        try:
+            value = float(text)
+        except ValueError:
+            raise ConfigError(
+                f"--effect {assignment!r}: expected a number, on or off for {name}.{field.name}"
+            ) from None
+    try:
+        return config_from_dict({"effects": {name: {field.name: value}}}, base=config)
+    except ConfigError as exc:
+        raise ConfigError(f"--effect {assignment!r}: {exc}") from None
+
+
+def with_effects(config: SimConfig, effects: dict[str, dict[str, float | str]]) -> SimConfig:
+    """A copy of `config` with effect parameters set, e.g. {"body_inertia": {"tau_s": 0.1}}."""
+    return config_from_dict({"effects": effects}, base=config)
