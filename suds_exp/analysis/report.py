@@ -1,0 +1,282 @@
+"""The campaign report: figures, tables (CSV + Markdown) and one ``index.html`` page.
+
+`write_report` is the whole of ``suds-exp report``; `report_tables` gives a notebook user
+the same tables as DataFrames without writing files.
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pandas as pd
+
+from suds_exp.analysis import plots
+from suds_exp.analysis.categories import at_cycles, category_table, learner_order
+from suds_exp.analysis.errors import AnalysisError
+from suds_exp.analysis.glm import REFERENCE, glm_table
+from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
+from suds_exp.analysis.queries import load_results
+from suds_exp.analysis.spread import iqr_table, slope_table
+from suds_exp.analysis.tables import to_html, to_markdown, write_table
+from suds_exp.store import Store
+
+_SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
+
+
+def report_tables(
+    results: pd.DataFrame,
+    n_cycles: int | None = None,
+    paper_dir: Path | None = None,
+    upper_from: int | None = None,
+) -> dict[str, pd.DataFrame]:
+    """Every table of the report, from labelled results (see `load_results`).
+
+    Keys: ``categories``, ``glm`` (100 ln scale), ``glm_rmse`` (mm/s), ``iqr``, ``slopes``,
+    and, when the paper's tables are found (``paper_dir`` or the default), ``compare_glm``
+    (both scales, column ``scale``), ``compare_iqr`` and ``agreement``. A part that the
+    results cannot support (no same-frequency pairs, say) is left out.
+    """
+    tables: dict[str, pd.DataFrame] = {"categories": category_table(results, n_cycles)}
+    tables["glm"] = glm_table(results, n_cycles, response="log")
+    tables["glm_rmse"] = glm_table(results, n_cycles, response="rmse")
+    try:
+        tables["iqr"] = iqr_table(results)
+        tables["slopes"] = slope_table(results, upper_from)
+    except AnalysisError:
+        pass
+    try:
+        paper_glm, paper_iqr = paper_table("glm", paper_dir), paper_table("iqr", paper_dir)
+    except AnalysisError:
+        return tables
+    tables["compare_glm"] = pd.concat(
+        [
+            compare_glm(tables["glm"], paper_glm).assign(scale="100 ln"),
+            compare_glm(tables["glm_rmse"], paper_glm).assign(scale="mm/s"),
+        ],
+        ignore_index=True,
+    )
+    iqr = tables.get("iqr", pd.DataFrame(columns=["frequency_hz", "model", "n_cycles", "iqr"]))
+    tables["compare_iqr"] = compare_iqr(iqr, paper_iqr)
+    log_part = tables["compare_glm"][tables["compare_glm"]["scale"] == "100 ln"]
+    rmse_part = tables["compare_glm"][tables["compare_glm"]["scale"] == "mm/s"]
+    summary = agreement_summary(log_part, tables["compare_iqr"])
+    rmse_summary = agreement_summary(rmse_part, tables["compare_iqr"].iloc[:0])
+    rmse_summary["table"] += " (mm/s scale)"
+    tables["agreement"] = pd.concat([summary, rmse_summary], ignore_index=True)
+    return tables
+
+
+def iqr_wide(iqr: pd.DataFrame) -> dict[float, pd.DataFrame]:
+    """The spread table as the paper prints it: per frequency, learners by training size."""
+    out = {}
+    for freq, g in iqr.groupby("frequency_hz"):
+        wide = g.pivot(index="model", columns="n_cycles", values="iqr")
+        wide = wide.loc[learner_order(wide.index)]
+        wide.columns = [str(c) for c in wide.columns]
+        out[freq] = wide.reset_index()
+    return out
+
+
+_CSS = """
+body { font-family: sans-serif; max-width: 1400px; margin: 1em auto; padding: 0 1em; color: #222; }
+img { max-width: 100%; border: 1px solid #ddd; margin: 0.5em 0; }
+table { border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.85em; }
+th, td { border: 1px solid #ccc; padding: 2px 6px; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; }
+th { background: #f0f0f0; }
+code { background: #f4f4f4; padding: 0 3px; }
+.note { color: #555; }
+"""
+
+
+def _files(links: dict[str, Path]) -> str:
+    return " ".join(
+        f'<a href="{html.escape(p.name)}">{html.escape(p.name)}</a>' for p in links.values()
+    )
+
+
+def write_report(
+    store: Store,
+    campaign: str,
+    out_dir: str | Path | None = None,
+    *,
+    paper_dir: Path | None = None,
+    n_cycles: int | None = None,
+    upper_from: int | None = None,
+) -> Path:
+    """Write the report of ``campaign`` into ``out_dir`` (default ``reports/<campaign>``).
+
+    Files: ``boxplot_frequency.png``, ``boxplot_gait.png``, ``boxplot_combined.png``,
+    ``sample_efficiency.png``; ``categories``, ``glm``, ``glm_rmse``, ``iqr``, ``slopes``,
+    ``compare_glm``, ``compare_iqr``, ``agreement`` as ``.csv`` and ``.md``; and
+    ``index.html``, which shows them all and loads nothing from the network.
+
+    Parameters
+    ----------
+    store : Store
+    campaign : str
+    out_dir : path, optional
+    paper_dir : path, optional
+        Folder of the paper's ``glm_table.csv`` / ``iqr_table.csv`` (default: see
+        `suds_exp.analysis.paper.default_paper_dir`); without them the comparison is skipped.
+    n_cycles : int, optional
+        Training size of the box plots and GLMs (default the campaign's most common).
+    upper_from : int, optional
+        First training size of the slope fits (default the median size).
+
+    Returns
+    -------
+    Path of ``index.html``.
+    """
+    if out_dir is None:
+        if not _SAFE_NAME.match(campaign):
+            raise AnalysisError(f"campaign {campaign!r} is not a safe folder name; pass --out DIR")
+        out_dir = Path("reports") / campaign
+    out = Path(out_dir)
+    results = load_results(store, campaign)
+    _, size = at_cycles(results, n_cycles)
+    out.mkdir(parents=True, exist_ok=True)
+    tables = report_tables(results, size, paper_dir, upper_from)
+
+    figures = plots.category_boxplots(results, out, size)
+    if "iqr" in tables:
+        figures["sample_efficiency"] = plots.efficiency_figure(
+            tables["iqr"], tables["slopes"], out / "sample_efficiency.png"
+        )
+
+    files: dict[str, dict[str, Path]] = {}
+    digits = {"compare_iqr": 2, "iqr": 3, "slopes": 3, "agreement": 2}
+    for name, frame in tables.items():
+        md = None
+        if name == "iqr":
+            md = "".join(
+                f"### IQR of RMS error of vx (mm/s) at {plots.frequency_name(f)} Hz\n\n"
+                f"{to_markdown(w)}\n"
+                for f, w in iqr_wide(frame).items()
+            )
+        files[name] = write_table(frame, out, name, digits.get(name, 2), md)
+
+    page = _page(campaign, store, results, size, tables, figures, files)
+    index = out / "index.html"
+    index.write_text(page, encoding="utf-8")
+    return index
+
+
+def _page(campaign, store, results, size, tables, figures, files) -> str:
+    esc = html.escape
+    glm = tables["glm"]
+    refs = glm.attrs["reference"]
+    models = ", ".join(learner_order(results["model"]))
+    sizes = ", ".join(str(v) for v in sorted(results["n_cycles"].unique()))
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        f"<title>suds-exp report: {esc(campaign)}</title><style>{_CSS}</style></head><body>",
+        f"<h1>Campaign <code>{esc(campaign)}</code></h1>",
+        f"<p>{len(results)} results from <code>{esc(str(store.path))}</code>; "
+        f"learners {esc(models)}; "
+        f"training sizes (cycles) {esc(sizes)}. Box plots and GLMs use the {size}-cycle results. "
+        f"Written {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.</p>",
+        "<h2>1. Log RMS error by similarity category</h2>",
+        '<p class="note">Gait similarity: steps between training and test gait on the axis '
+        "S+, S-, O, D-, D+ (same 0, near 1, far more than 1). Frequency: same or different "
+        "training and test frequency. Box plots with matplotlib's default parameters.</p>",
+    ]
+    for key in ("boxplot_frequency", "boxplot_gait", "boxplot_combined"):
+        parts.append(f'<img src="{esc(figures[key].name)}" alt="{esc(key)}">')
+    parts += [
+        "<h3>Numbers behind the box plots (ln of mm/s)</h3>",
+        f"<p>Files: {_files(files['categories'])}</p>",
+        to_html(tables["categories"], 3),
+        "<h2>2. GLM of log RMS error</h2>",
+        f"<p>Response: <code>y = {esc(glm.attrs['response'])}</code> (a coefficient of -10 is "
+        "about 10 % less error; independent of the error's unit). Gaussian GLM, identity link, "
+        f"{glm.attrs['n_rows']} learner results at {size} cycles, phase-only left out "
+        "(it has neither SUDS nor GMR and would count as TLS). 95 % confidence intervals; "
+        "terms sorted by magnitude after the intercept.</p>",
+        "<p>Reference levels, as the paper: TLS (SUDS = GMR = 0), "
+        + ", ".join(esc(v) for v in refs.values())
+        + "."
+        + (
+            ""
+            if all(glm.attrs["reference"].get(k) for k in REFERENCE)
+            else " (A factor with one level in these results is left out of the model.)"
+        )
+        + "</p>",
+    ]
+    if glm.attrs["rank_deficient"]:
+        parts.append(
+            '<p class="note"><b>Warning:</b> some category combinations are missing from these '
+            "results, so not every interaction is identifiable; read those coefficients with "
+            "care.</p>"
+        )
+    for label in ("direct", "interactions"):
+        parts += [
+            f"<h3>{'Direct effects' if label == 'direct' else 'First-order interactions'}</h3>",
+            f"<p><code>{esc(glm.attrs['formulas'][label])}</code></p>",
+            to_html(glm[glm["model"] == label].drop(columns="model"), 2),
+        ]
+    parts += [f"<p>Files: {_files(files['glm'])}</p>"]
+    raw = tables["glm_rmse"]
+    parts += [
+        "<h3>The same GLMs on the RMS error itself (mm/s)</h3>",
+        '<p class="note">The paper reads its coefficients as fractions of the intercept '
+        "(e.g. -47.53 / 91.36 as a 52 % reduction), i.e. as linear in RMS error; these fits "
+        "let that reading be checked. Their size depends on the unit.</p>",
+    ]
+    for label in ("direct", "interactions"):
+        parts.append(to_html(raw[raw["model"] == label], 2))
+    parts.append(f"<p>Files: {_files(files['glm_rmse'])}</p>")
+
+    parts.append("<h2>3. Spread: IQR of RMS error of vx</h2>")
+    if "iqr" in tables:
+        parts.append(
+            '<p class="note">Results trained and tested at the same frequency, gait pairings '
+            "pooled, by learner (rows) and training cycles (columns); mm/s.</p>"
+        )
+        for freq, wide in iqr_wide(tables["iqr"]).items():
+            parts += [f"<h3>{plots.frequency_name(freq)} Hz</h3>", to_html(wide, 2)]
+        parts.append(f"<p>Files (long form, with quartiles and counts): {_files(files['iqr'])}</p>")
+        parts += [
+            "<h2>4. Sample efficiency</h2>",
+            f'<img src="{esc(figures["sample_efficiency"].name)}" alt="sample_efficiency">',
+            '<p class="note">Median (line) and IQR (band) of the RMS error against training '
+            "cycles, log-log. Slope: least squares of ln RMS error on ln cycles over the "
+            "upper range of training sizes, with 95 % interval (-0.5 is the rate of averaging "
+            "white noise).</p>",
+            to_html(tables["slopes"], 3),
+            f"<p>Files: {_files(files['slopes'])}</p>",
+        ]
+    else:
+        parts.append(
+            "<p>No results trained and tested at the same frequency: no spread table "
+            "and no sample-efficiency figure.</p>"
+        )
+
+    parts.append("<h2>5. Beside the paper</h2>")
+    if "compare_glm" in tables:
+        parts += [
+            '<p class="note">The paper\'s rows with our numbers beside them. Sign agreement per '
+            "term; rank = place by magnitude within its model (GLM, intercept not ranked) or "
+            "by IQR among the learners at one frequency and training size (1 = smallest). "
+            "Kendall's tau compares the two orderings. Magnitudes are not comparable across "
+            "units; signs and orderings are.</p>",
+            to_html(tables["agreement"], 2),
+            f"<p>Files: {_files(files['agreement'])}</p>",
+            "<h3>GLM</h3>",
+            to_html(tables["compare_glm"], 2),
+            f"<p>Files: {_files(files['compare_glm'])}</p>",
+            "<h3>IQR</h3>",
+            to_html(tables["compare_iqr"], 2),
+            f"<p>Files: {_files(files['compare_iqr'])}</p>",
+        ]
+    else:
+        parts.append(
+            "<p>The paper's tables were not found (pass <code>--paper DIR</code>); "
+            "no comparison.</p>"
+        )
+    parts.append("</body></html>")
+    return "\n".join(parts)

@@ -1,0 +1,163 @@
+"""Synthetic ``results`` rows with effects of known size, for tests, benchmarks and demos.
+
+Each learner result's ``100 ln(rmse_vx)`` is a sum of planted GLM coefficients (named as
+the GLM table names its terms), a power law in the number of training cycles, and
+Gaussian noise; phase-only results get the intercept plus an offset. So fitting the GLM
+and the sample-efficiency slopes to these rows should give back what was planted.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.analysis.categories import GAIT_AXIS, LEARNERS
+
+FREQUENCIES_HZ = (1 / 3, 1 / 2, 1.0)
+
+#: The paper's first-order-interactions GLM (its Table "GLM coefficient comparison"), used
+#: as the default truth so a synthetic report can be read beside the paper's.
+PAPER_INTERACTIONS = {
+    "Intercept": 91.36,
+    "GMR": -56.32,
+    "SUDS": -47.53,
+    "SUDS:GMR": 40.36,
+    "model-period<data-period": -19.80,
+    "model-period=data-period": -18.98,
+    "SUDS:(model-period<data-period)": 17.34,
+    "GMR:(model-period<data-period)": 15.99,
+    "GMR:(model-period=data-period)": 10.11,
+    "SUDS:(model-period=data-period)": 8.52,
+    "GMR:(model-gait far from data-gait)": 6.59,
+    "(model-period<data-period):(model-gait far from data-gait)": 5.73,
+    "SUDS:(model-gait far from data-gait)": 4.52,
+    "(model-period=data-period):(model-gait far from data-gait)": 4.01,
+    "model-gait=data-gait": -4.07,
+    "(model-period=data-period):(model-gait=data-gait)": -3.02,
+    "model-gait far from data-gait": -1.58,
+    "(model-period<data-period):(model-gait=data-gait)": -1.34,
+    "SUDS:(model-gait=data-gait)": -0.26,
+    "GMR:(model-gait=data-gait)": -0.19,
+}
+
+#: Default log-log slopes of RMS error against training cycles.
+DEFAULT_SLOPES = {"phase-only": 0.0, "TLS": -0.05, "TLS+SUDS": -0.1, "GMR": -0.3, "GMR+SUDS": -0.5}
+
+
+def _indicators(frame: pd.DataFrame) -> dict[str, np.ndarray]:
+    return {
+        "SUDS": frame["model"].str.endswith("+SUDS").to_numpy(),
+        "GMR": frame["model"].str.startswith("GMR").to_numpy(),
+        "model-period<data-period": (
+            frame["train_frequency_hz"] > frame["test_frequency_hz"] + 1e-9
+        ).to_numpy(),
+        "model-period=data-period": (
+            np.abs(frame["train_frequency_hz"] - frame["test_frequency_hz"]) <= 1e-9
+        ).to_numpy(),
+        "model-gait=data-gait": (frame["_steps"] == 0).to_numpy(),
+        "model-gait far from data-gait": (frame["_steps"] > 1).to_numpy(),
+    }
+
+
+def term_indicator(term: str, basic: dict[str, np.ndarray]) -> np.ndarray:
+    """0/1 column of a GLM term named as the GLM table names it (``A:(B)`` = A and B)."""
+    n = len(next(iter(basic.values())))
+    if term == "Intercept":
+        return np.ones(n)
+    out = np.ones(n)
+    for part in term.split(":"):
+        out = out * basic[part.strip("()")]
+    return out
+
+
+def synthetic_results(
+    campaign: str = "synthetic",
+    effects: dict[str, float] | None = None,
+    *,
+    n_boot: int = 4,
+    n_cycles=(30,),
+    slopes: dict[str, float] | None = None,
+    phase_only_offset: float = 60.0,
+    noise: float = 30.0,
+    models=LEARNERS,
+    seed: int = 0,
+) -> pd.DataFrame:
+    """Rows in the ``results`` table's columns, one per (model, train, test, n_cycles, boot).
+
+    Parameters
+    ----------
+    campaign : str
+    effects : dict term -> coefficient, optional
+        Planted GLM coefficients on the ``100 ln(rmse_vx / (mm/s))`` scale, for the learner
+        rows; terms absent are 0. Default `PAPER_INTERACTIONS`.
+    n_boot : int
+        Bootstrap repeats per (model, train condition, test condition, n_cycles).
+    n_cycles : sequence of int
+        Training sizes; every size gets the full 15 x 15 condition grid.
+    slopes : dict model -> float, optional
+        Log-log slope of RMS error against ``n_cycles`` (relative to the largest size);
+        default `DEFAULT_SLOPES`.
+    phase_only_offset : float
+        Phase-only results: intercept plus this, on the same scale.
+    noise : float
+        Standard deviation of the Gaussian noise on the ``100 ln`` scale.
+    models : sequence of str
+    seed : int
+
+    Returns
+    -------
+    DataFrame with the ``results`` columns (``rmse_vx``, ``rmse_vy`` mm/s, ``rmse_wz`` rad/s).
+    """
+    effects = dict(PAPER_INTERACTIONS if effects is None else effects)
+    slopes = {**DEFAULT_SLOPES, **(slopes or {})}
+    rng = np.random.default_rng(seed)
+    conditions = [(g, round(f, 6)) for g in GAIT_AXIS for f in FREQUENCIES_HZ]
+    grid = pd.DataFrame(
+        [
+            (m, tg, tf, dg, df, n, b)
+            for m, (tg, tf), (dg, df), n, b in itertools.product(
+                models, conditions, conditions, n_cycles, range(n_boot)
+            )
+        ],
+        columns=[
+            "model",
+            "train_gait",
+            "train_frequency_hz",
+            "test_gait",
+            "test_frequency_hz",
+            "n_cycles",
+            "boot",
+        ],
+    )
+    pos = {g: i for i, g in enumerate(GAIT_AXIS)}
+    grid["_steps"] = np.abs(grid["train_gait"].map(pos) - grid["test_gait"].map(pos))
+    basic = _indicators(grid)
+    y = np.zeros(len(grid))
+    for term, coef in effects.items():
+        y += coef * term_indicator(term, basic)
+    phase_only = (grid["model"] == "phase-only").to_numpy()
+    y[phase_only] = effects.get("Intercept", 0.0) + phase_only_offset
+    slope = grid["model"].map(slopes).fillna(0.0).to_numpy()
+    y += 100.0 * slope * np.log(grid["n_cycles"].to_numpy() / max(n_cycles))
+    y += rng.normal(0.0, noise, len(grid))
+    n = len(grid)
+    grid["rmse_vx"] = np.exp(y / 100.0)
+    grid["rmse_vy"] = np.exp(rng.normal(0.0, 0.3, n))
+    grid["rmse_wz"] = np.exp(rng.normal(-3.0, 0.3, n))
+    grid["campaign"] = campaign
+    trial = rng.integers(1, 61, size=(n, 2))
+    grid["train_trials"] = [json.dumps([int(t)]) for t in trial[:, 0]]
+    grid["train_ranges"] = [
+        json.dumps([[int(t), 0, int(c) - 1]])
+        for t, c in zip(trial[:, 0], grid["n_cycles"], strict=True)
+    ]
+    grid["test_trial"] = trial[:, 1]
+    grid["test_range"] = json.dumps([0, 9])
+    grid["n_test"] = 1000
+    grid["fit_seconds"] = rng.uniform(0.01, 1.0, n)
+    grid["predict_seconds"] = rng.uniform(0.01, 0.1, n)
+    grid["finished_at"] = pd.Timestamp("2026-01-01")
+    return grid.drop(columns="_steps")

@@ -1,0 +1,69 @@
+"""Writing tables as CSV, Markdown and HTML fragments."""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+
+def _cell(value, digits: int) -> str:
+    if value is None or value is pd.NA or (isinstance(value, float) and np.isnan(value)):
+        return ""
+    if isinstance(value, bool | np.bool_):
+        return "yes" if value else "no"
+    if isinstance(value, float | np.floating):
+        return f"{value:.{digits}f}"
+    return str(value)
+
+
+def formatted(frame: pd.DataFrame, digits: int = 2) -> list[list[str]]:
+    """The frame's cells as strings: floats to ``digits`` decimals, booleans yes/no, NA blank."""
+    return [[_cell(v, digits) for v in row] for row in frame.itertuples(index=False)]
+
+
+def to_markdown(frame: pd.DataFrame, digits: int = 2) -> str:
+    """A GitHub-flavoured Markdown table of ``frame`` (numbers right-aligned)."""
+    header = [str(c) for c in frame.columns]
+    align = [
+        "---:" if pd.api.types.is_numeric_dtype(frame[c]) and frame[c].dtype != bool else "---"
+        for c in frame.columns
+    ]
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join(align) + "|"]
+    lines += [
+        "| " + " | ".join(c.replace("|", "\\|") for c in row) + " |"
+        for row in formatted(frame, digits)
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def to_html(frame: pd.DataFrame, digits: int = 2) -> str:
+    """An HTML ``<table>`` of ``frame`` (escaped; numbers right-aligned)."""
+    numeric = [
+        pd.api.types.is_numeric_dtype(frame[c]) and frame[c].dtype != bool for c in frame.columns
+    ]
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in frame.columns)
+    body = []
+    for row in formatted(frame, digits):
+        cells = "".join(
+            f'<td class="num">{html.escape(v)}</td>' if num else f"<td>{html.escape(v)}</td>"
+            for v, num in zip(row, numeric, strict=True)
+        )
+        body.append(f"<tr>{cells}</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def write_table(
+    frame: pd.DataFrame, out_dir: Path, name: str, digits: int = 2, markdown: str | None = None
+) -> dict[str, Path]:
+    """Write ``name.csv`` (full precision) and ``name.md`` (``markdown`` if given, else
+    ``frame`` rounded to ``digits``); return kind -> path."""
+    csv = out_dir / f"{name}.csv"
+    md = out_dir / f"{name}.md"
+    frame.to_csv(csv, index=False)
+    md.write_text(
+        markdown if markdown is not None else to_markdown(frame, digits), encoding="utf-8"
+    )
+    return {"csv": csv, "md": md}
