@@ -67,6 +67,28 @@ from suds_exp.models.base import (
 from suds_exp.models.mixture import Conditional, fit_mixture, responsibilities
 
 
+def history_features(samples: pd.DataFrame, memory: float) -> np.ndarray:
+    """Where the actuated shape came from: r_a(s) - r_a(s - memory), shape (n, 2), rad.
+
+    s is the arc length travelled in actuated-shape space within each trial (rad), so the
+    feature is rate-independent; before a trial has travelled `memory` rad the chord
+    reaches back to its first sample. Returned in the caller's row order.
+    """
+    ts = TimeSeries.of(samples)
+    ra = as_array(samples, RA_COLUMNS, "GMR")[ts.order]
+    step = np.linalg.norm(np.diff(ra, axis=0, prepend=ra[:1]), axis=1)
+    step[ts.first] = 0.0
+    out = np.empty_like(ra)
+    for a, b in zip(ts.starts[:-1], ts.starts[1:], strict=True):
+        s = np.cumsum(step[a:b])
+        # strictly increasing abscissa for interp even where the shape stood still
+        s = s + np.arange(b - a) * 1e-12
+        back = s - memory
+        for j in range(2):
+            out[a:b, j] = ra[a:b, j] - np.interp(back, s, ra[a:b, j])
+    return ts.unsort(out)
+
+
 def forward_filter(log_emit, transition, priors, first) -> np.ndarray:
     """Filtered branch probabilities alpha, shape (n, K), for time-ordered samples.
 
@@ -129,12 +151,15 @@ class GMR(Learner):
         reg_covar: float = 1e-3,
         max_iter: int = 60,
         tol: float = 1e-3,
-        augment: str = "dilation",
+        augment: str = "homogeneous",
         augment_range: tuple = (0.5, 2.0),
         augment_copies: int = 1,
         augment_weight: float = 0.5,
-        branching: str = "filter",
+        augment_power: float = 1.0,
+        speed_floor: float = 0.1,
+        branching: str = "none",
         branch_mix: float = 0.1,
+        branch_memory: float = 1.0,
         select_k: str = "none",
         k_candidates: tuple = (4, 8, 12, 16),
         random_state: int = 0,
@@ -147,8 +172,11 @@ class GMR(Learner):
         self.augment_range = augment_range
         self.augment_copies = augment_copies
         self.augment_weight = augment_weight
+        self.augment_power = augment_power
+        self.speed_floor = speed_floor
         self.branching = branching
         self.branch_mix = branch_mix
+        self.branch_memory = branch_memory
         self.select_k = select_k
         self.k_candidates = k_candidates
         self.random_state = random_state
@@ -164,7 +192,9 @@ class GMR(Learner):
         check_float("reg_covar", self.reg_covar, 0.0, n, strict=True)
         check_int("max_iter", self.max_iter, 1, n)
         check_float("tol", self.tol, 0.0, n)
-        check_choice("augment", self.augment, ("dilation", "none"), n)
+        check_choice("augment", self.augment, ("homogeneous", "dilation", "none"), n)
+        check_float("augment_power", self.augment_power, 0.0, n)
+        check_float("speed_floor", self.speed_floor, 0.0, n, strict=True)
         rng_ok = (
             isinstance(self.augment_range, tuple | list)
             and len(self.augment_range) == 2
@@ -178,7 +208,8 @@ class GMR(Learner):
             )
         check_int("augment_copies", self.augment_copies, 0, n)
         check_float("augment_weight", self.augment_weight, 0.0, n)
-        check_choice("branching", self.branching, ("filter", "none"), n)
+        check_choice("branching", self.branching, ("history", "filter", "none"), n)
+        check_float("branch_memory", self.branch_memory, 0.0, n, strict=True)
         check_float("branch_mix", self.branch_mix, 0.0, n)
         if self.branch_mix > 1:
             raise ConfigError(f"{n}: branch_mix={self.branch_mix!r}; expected a number in [0, 1]")
@@ -195,11 +226,15 @@ class GMR(Learner):
         self._validate()
         cin, cout, rp_cols, drp_cols = self._columns(samples)
         require_columns(samples, ("trial_id", "t", *cin, *cout), self.name)
-        Z = as_array(samples, cin + cout, self.name)
         self.columns_in_, self.columns_out_ = cin, cout
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
-        rate = np.array([c.startswith("d") or c in VB_COLUMNS for c in cin + cout])
         rng = np.random.default_rng(self.random_state)
+        speed = np.linalg.norm(as_array(samples, DRA_COLUMNS, self.name), axis=1)
+        self.speed_floor_ = self.speed_floor * float(np.median(speed))
+        Xin, f = self._inputs(samples)
+        Z = np.hstack([Xin, as_array(samples, cout, self.name) / f[:, None]])
+        names = cin + (["hist_1", "hist_2"] if self.branching == "history" else []) + cout
+        rate = np.array([c.startswith("d") or c in VB_COLUMNS for c in names])
         self.center_ = Z.mean(axis=0)
         self.scale_ = np.where(Z.std(axis=0) > 0, Z.std(axis=0), 1.0)
         data, weights = [Z], [np.ones(len(Z))]
@@ -224,7 +259,7 @@ class GMR(Learner):
         self.n_iter_, self.converged_ = best.n_iter, best.converged
         self.n_components_ = len(best.priors)
         self.bic_ = best_bic
-        d = len(cin)
+        d = Xin.shape[1]
         self._cond = Conditional.of(
             self.priors_, self.means_, self.covariances_, np.arange(d), np.arange(d, len(rate))
         )
@@ -240,6 +275,30 @@ class GMR(Learner):
         self.n_features_in_ = d
         return self
 
+    def _inputs(self, samples):
+        """Model inputs (n, d) in the caller's order and the rate divisor f (n,).
+
+        Columns `columns_in_` with dr_a/dt divided by f (see `_homogeneity`), then the
+        history features when branching="history".
+        """
+        X = as_array(samples, self.columns_in_, self.name)
+        f = self._homogeneity(samples)
+        X[:, [c in DRA_COLUMNS for c in self.columns_in_]] /= f[:, None]
+        if self.branching == "history":
+            X = np.hstack([X, history_features(samples, self.branch_memory)])
+        return X, f
+
+    def _homogeneity(self, samples) -> np.ndarray:
+        """rho^alpha per sample, shape (n,): what rates are divided by ("homogeneous").
+
+        rho = sqrt(|dr_a/dt|^2 + speed_floor_^2) in rad/s; all ones for other augments.
+        """
+        if self.augment != "homogeneous" or self.augment_power == 0:
+            return np.ones(len(samples))
+        dra = as_array(samples, DRA_COLUMNS, self.name)
+        rho = np.sqrt((dra * dra).sum(axis=1) + self.speed_floor_**2)
+        return rho**self.augment_power
+
     # -- predict -------------------------------------------------------------------------
     def _gates(self, Xs, ts):
         """Branch/gate weights (n, K) for standardised inputs in sorted order."""
@@ -252,13 +311,13 @@ class GMR(Learner):
         return h / h.sum(axis=1, keepdims=True)
 
     def _predict_measured(self, samples):
-        d = len(self.columns_in_)
-        Xin = as_array(samples, self.columns_in_, self.name)
+        Xin, f = self._inputs(samples)
+        d = Xin.shape[1]
         ts = TimeSeries.of(samples)
         Xs = ((Xin - self.center_[:d]) / self.scale_[:d])[ts.order]
         h = self._gates(Xs, ts)
         ys = np.einsum("nk,nkq->nq", h, self._cond.local_means(Xs))
-        return ts.unsort(ys * self.scale_[d:] + self.center_[d:])
+        return ts.unsort(ys * self.scale_[d:] + self.center_[d:]) * f[:, None]
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
@@ -284,12 +343,15 @@ class GMRSuds(GMR):
         reg_covar: float = 1e-3,
         max_iter: int = 60,
         tol: float = 1e-3,
-        augment: str = "dilation",
+        augment: str = "homogeneous",
         augment_range: tuple = (0.5, 2.0),
         augment_copies: int = 1,
         augment_weight: float = 0.5,
-        branching: str = "filter",
+        augment_power: float = 1.0,
+        speed_floor: float = 0.1,
+        branching: str = "none",
         branch_mix: float = 0.1,
+        branch_memory: float = 1.0,
         select_k: str = "none",
         k_candidates: tuple = (4, 8, 12, 16),
         random_state: int = 0,
@@ -304,8 +366,11 @@ class GMRSuds(GMR):
             augment_range,
             augment_copies,
             augment_weight,
+            augment_power,
+            speed_floor,
             branching,
             branch_mix,
+            branch_memory,
             select_k,
             k_candidates,
             random_state,
@@ -328,14 +393,27 @@ class GMRSuds(GMR):
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
         if self.mode == "measured":
             return self._output_frame(self._predict_measured(samples), samples)
-        return self._output_frame(self._predict_rollout(samples), samples)
+        return self._output_frame(self._predict_rollout(samples)[0], samples)
+
+    def rollout(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """r_p integrated from each trial's first sample, columns rp_1..rp_k, input's index.
+
+        Uses r_a, dr_a/dt of every sample and r_p of each trial's first sample only.
+        """
+        self._check_fitted()
+        require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
+        return pd.DataFrame(
+            self._predict_rollout(samples)[1], index=samples.index, columns=self.rp_columns_
+        )
 
     def _predict_rollout(self, samples):
-        d = len(self.columns_in_)
+        """(outputs (n, 3 + k), rolled-out r_p (n, k)) in the caller's order."""
         k = len(self.rp_columns_)
-        Xin = as_array(samples, self.columns_in_, self.name)
+        Xin, f = self._inputs(samples)
+        d = Xin.shape[1]
         ts = TimeSeries.of(samples)
         Xs = ((Xin - self.center_[:d]) / self.scale_[:d])[ts.order]
+        fs = f[ts.order]
         # r_p occupies inputs 2..2+k and outputs 3..3+k; in standardised units one Euler
         # step is rp_s += dt * drp_s * scale_out / scale_in.
         gain = self.scale_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
@@ -349,6 +427,7 @@ class GMRSuds(GMR):
         T, pri = self.transition_, self.priors_
         first = ts.first
         out = np.empty((len(Xs), mu_out.shape[1]))
+        rp = np.empty((len(Xs), k))
         a = pri
         x = Xs[0].copy()
         for t in range(len(Xs)):
@@ -358,7 +437,9 @@ class GMRSuds(GMR):
                 x[:2] = Xs[t, :2]
                 x[2 + k :] = Xs[t, 2 + k :]
                 x[2 : 2 + k] = np.clip(
-                    x[2 : 2 + k] + ts.dt[t] * (gain * out[t - 1, 3 : 3 + k] + off), lo, hi
+                    x[2 : 2 + k] + ts.dt[t] * fs[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off),
+                    lo,
+                    hi,
                 )
             diff = x - mu_in
             yk = np.einsum("kd,kde->ke", diff, P)
@@ -373,4 +454,6 @@ class GMRSuds(GMR):
             a = a / s if s > 0 else pri
             ys = a @ (mu_out + np.einsum("kqd,kd->kq", reg, diff))
             out[t] = ys
-        return ts.unsort(out * self.scale_[d:] + self.center_[d:])
+            rp[t] = x[2 : 2 + k]
+        rp = rp * self.scale_[2 : 2 + k] + self.center_[2 : 2 + k]
+        return ts.unsort(out * self.scale_[d:] + self.center_[d:]) * f[:, None], ts.unsort(rp)

@@ -57,7 +57,7 @@ def require_columns(samples: pd.DataFrame, columns, model: str) -> None:
 
 def as_array(samples: pd.DataFrame, columns, model: str) -> np.ndarray:
     """Columns as a float array of shape (n_samples, len(columns)); NaN/inf is an error."""
-    x = samples.loc[:, list(columns)].to_numpy(dtype=float)
+    x = samples.loc[:, list(columns)].to_numpy(dtype=float, copy=True)
     if not np.isfinite(x).all():
         bad = [c for c, ok in zip(columns, np.isfinite(x).all(axis=0), strict=True) if not ok]
         raise ModelError(f"{model}: column(s) {', '.join(bad)} hold NaN or inf values")

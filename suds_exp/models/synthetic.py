@@ -73,7 +73,7 @@ def _finsler_bias(ra: np.ndarray) -> np.ndarray:
 def _wobble(t: np.ndarray, f: float, tube: float, rng) -> tuple[np.ndarray, np.ndarray]:
     """Smooth per-trial perturbation (n, 4) = (amp1, amp2, off1, off2) and its rate."""
     n_modes = 3
-    freqs = f * rng.uniform(0.05, 0.6, size=(n_modes, 4))
+    freqs = f * rng.uniform(0.05, 1.5, size=(n_modes, 4))
     phases = rng.uniform(0, 2 * np.pi, size=(n_modes, 4))
     amps = tube / np.sqrt(n_modes) * rng.uniform(0.5, 1.5, size=(n_modes, 4))
     arg = 2 * np.pi * freqs[None] * t[:, None, None] + phases[None]
@@ -82,7 +82,7 @@ def _wobble(t: np.ndarray, f: float, tube: float, rng) -> tuple[np.ndarray, np.n
     return e, de
 
 
-def _trial(n_cycles, gait, f, spc, tube, passive, velocity, tau, ell, substeps, rng):
+def _trial(n_cycles, gait, f, spc, tube, passive, velocity, tau, ell, substeps, rp_start, rng):
     n = int(round(n_cycles * spc))
     fs = f * spc
     nf = n * substeps
@@ -103,7 +103,7 @@ def _trial(n_cycles, gait, f, spc, tube, passive, velocity, tau, ell, substeps, 
         forcing = dra @ C_PASSIVE.T + lam[:, None] * (ra @ G_PASSIVE.T)
         h = 1.0 / (fs * substeps)
         rp = np.empty((nf, 2))
-        x = ra[0] @ G_PASSIVE.T
+        x = ra[0] @ G_PASSIVE.T + rp_start
         denom = 1.0 + h * lam
         for i in range(nf):  # implicit Euler: stable whatever tau, exact as h -> 0
             x = (x + h * forcing[i]) / denom[i]
@@ -134,13 +134,15 @@ def make_samples(
     noise_r: float = 0.0,
     noise_dr: float = 0.0,
     substeps: int = 10,
+    rp_start: tuple = (0.0, 0.0),
     first_trial_id: int = 1,
     seed: int = 0,
 ) -> pd.DataFrame:
     """A samples frame (columns of the `samples` table) from the synthetic swimmer.
 
     Extra columns `vx_true`, `vy_true`, `wz_true` (noise-free body velocity) and
-    `rp_true_*` (noise-free r_p) let a test compute the noise floor. Measured columns
+    `rp_true_*` (noise-free r_p) let a test compute the noise floor. r_p starts at
+    G r_a(0) + `rp_start` (its equilibrium plus an offset). Measured columns
     get Gaussian noise: v (noise_v mm/s, noise_w rad/s), r_a and r_p (noise_r),
     dr_a/dt and dr_p/dt (noise_dr per s). Trials are `first_trial_id`, ... in order.
     """
@@ -162,6 +164,7 @@ def make_samples(
             tau,
             ell,
             substeps,
+            np.asarray(rp_start, dtype=float),
             rng,
         )
         n = len(t)

@@ -11,13 +11,20 @@ Model (per phase bin k, Bittner et al. 2018 eq. for v_b)::
   passive dynamics dr_p/dt = C(r) dr_a/dt + D(r) alongside, linearised the same way
   (same regressors, outputs (v_b, dr_p/dt) in one total least squares per bin). Only
   dr_a/dt enters the right-hand side: SUDS makes dr_p/dt unnecessary there.
+- The outputs' phase mean (Fourier order `gait_order`) is removed first and added back
+  at prediction, so a bin only carries the residual.
 - Each bin is a window of the phase circle (`n_bins` centres, window `bin_width` bins
-  wide); a bin holding fewer than `min_bin_factor` x (regressors + outputs) samples
-  takes that many phase-nearest samples instead, so few-cycle training stays defined.
-- Total least squares (errors in variables): centre [X y] on the bin means, scale each
-  column by its standard deviation, take the SVD solution per output; regressor
-  directions with no more spread than the noise are truncated (`tls_gap`, see
-  `tls_solve`), which keeps TLS from exploding on near-collinear regressors.
+  wide) with the phase offset from the centre as one more regressor (dropped after the
+  fit); a bin holding fewer than `min_bin_factor` x (regressors + 2) samples takes that
+  many phase-nearest samples instead, so few-cycle training stays defined.
+- Total least squares (errors in variables): centre [X y] on the bin means, scale the
+  columns by the gait's whole excursion (std over the training data of r, of dr_a/dt,
+  their products for the bilinear terms, and of each output), take the SVD solution per
+  output (`tls_solve`). Regressor directions whose spread inside the bin is below
+  `min_spread` of that excursion are dropped (with one or two cycles delta is almost
+  constant per bin, and fitting it would extrapolate wildly), and so are directions
+  with no more spread than the noise (`tls_gap`): TLS explodes on those, e.g. r_p
+  following r_a almost exactly. An optional `ridge` shrinks the rest.
 - The bin coefficients (C, B, A, dA) are interpolated over phase by a Fourier series of
   order `coef_order` fitted to the bin centres.
 
@@ -53,18 +60,32 @@ from suds_exp.models.base import (
 _TWO_PI = 2.0 * np.pi
 
 
-def tls_solve(X: np.ndarray, Y: np.ndarray, gap: float = 2.0):
+def tls_solve(
+    X: np.ndarray,
+    Y: np.ndarray,
+    gap: float = 2.0,
+    scale_x: np.ndarray | None = None,
+    scale_y: np.ndarray | None = None,
+    min_spread: float = 0.0,
+    ridge: float = 0.0,
+):
     """Total least squares Y ~ c + X B from the SVD of the centred, column-scaled data.
 
     X: (n, p); Y: (n, q); each output is solved on its own after dividing every column
-    of X and y by its standard deviation. With Xs = U S V^T (principal components of the
-    regressors) and sigma the smallest singular value of [Xs ys], the TLS solution is
+    of X and y by a scale: `scale_x` (p,), `scale_y` (q,) when given (TLS uses the
+    spread over all training data, so that a regressor that barely moves inside one bin
+    stays small instead of being blown up to unit variance), else the column's own
+    standard deviation. Directions of the scaled regressors whose RMS spread is below
+    `min_spread` are not identifiable from these samples and are dropped. With
+    Xs = U S V^T (principal components of the regressors) and sigma the smallest singular
+    value of [Xs ys], the TLS solution is
     b = V (S^2 - sigma^2 I)^-1 S U^T ys, the closed form of the SVD solution of [Xs ys].
     TLS is undefined (and explodes) when a regressor direction carries no more spread
     than the noise, as with r_p following r_a almost exactly; such directions
     (S_i^2 <= gap * sigma^2, recomputing sigma on the directions kept) are truncated,
     which bounds the TLS de-attenuation of any kept direction by 1 / (1 - 1 / gap).
-    Columns with zero spread get coefficient 0.
+    `ridge` (scaled units, per sample) adds ridge * n to S^2 - sigma^2. Columns with zero
+    spread get coefficient 0.
 
     Returns (c of shape (q,), B of shape (p, q), number of regressor directions kept,
     summed over outputs).
@@ -73,8 +94,9 @@ def tls_solve(X: np.ndarray, Y: np.ndarray, gap: float = 2.0):
     q = Y.shape[1]
     xm, ym = X.mean(axis=0), Y.mean(axis=0)
     Xc, Yc = X - xm, Y - ym
-    sx, sy = Xc.std(axis=0), Yc.std(axis=0)
-    live = sx > 1e-12 * max(1.0, float(np.abs(X).max(initial=0.0)))
+    sx = Xc.std(axis=0) if scale_x is None else np.asarray(scale_x, dtype=float)
+    sy = Yc.std(axis=0) if scale_y is None else np.asarray(scale_y, dtype=float)
+    live = (Xc.std(axis=0) > 1e-12 * max(1.0, float(np.abs(X).max(initial=0.0)))) & (sx > 0)
     sy = np.where(sy > 0, sy, 1.0)
     B = np.zeros((p, q))
     n_kept = 0
@@ -86,7 +108,7 @@ def tls_solve(X: np.ndarray, Y: np.ndarray, gap: float = 2.0):
     proj = U.T @ Ys  # (r, q): each output in principal-component coordinates
     resid2 = np.maximum((Ys * Ys).sum(axis=0) - (proj * proj).sum(axis=0), 0.0)
     for j in range(q):
-        keep = S > 1e-12 * S[0]
+        keep = (S > 1e-12 * S[0]) & (S > min_spread * np.sqrt(n))
         for _ in range(4):
             # smallest singular value of [U_k S_k, ys]: the smallest root of the secular
             # equation, found from the small (k+1) x (k+1) Gram matrix.
@@ -103,7 +125,7 @@ def tls_solve(X: np.ndarray, Y: np.ndarray, gap: float = 2.0):
                 break
             keep = new
         if keep.any():
-            bpc = S[keep] * proj[keep, j] / (S[keep] ** 2 - sig2)
+            bpc = S[keep] * proj[keep, j] / (S[keep] ** 2 - sig2 + ridge * n)
             B[live, j] = (Vt[keep].T @ bpc) / sx[live] * sy[j]
             n_kept += int(keep.sum())
     return ym - xm @ B, B, n_kept
@@ -135,13 +157,21 @@ class TLS(Learner):
         Regressor directions whose squared singular value is not above tls_gap times the
         TLS noise level are truncated (> 1; large values approach principal-component
         regression, values near 1 plain TLS).
+    min_spread : float, default 0.02
+        Regressor directions whose RMS spread inside a bin is below this fraction of the
+        gait's excursion are dropped (not identifiable from the bin).
+    ridge : float, default 0.0
+        Ridge shrinkage of the TLS solve, in scaled units per sample.
 
     Attributes
     ----------
     gait_coef_ : array of shape (2 * gait_order + 1, n_r)
         Mean gait r_bar(phase) Fourier coefficients (rad for r_a, r_p units for r_p).
     coef_ : array of shape (2 * coef_order + 1, 1 + n_regressors, n_outputs)
-        Fourier coefficients over phase of [C; B; A; dA] per output.
+        Fourier coefficients over phase of [C; B; A; dA] per output (C without the
+        phase mean).
+    mean_coef_ : array of shape (2 * gait_order + 1, n_outputs)
+        Fourier coefficients of the outputs' phase mean.
     bin_coef_ : array of shape (n_bins, 1 + n_regressors, n_outputs)
         The raw per-bin TLS coefficients.
     kept_fraction_ : float
@@ -159,6 +189,8 @@ class TLS(Learner):
         coef_order: int = 3,
         min_bin_factor: float = 2.0,
         tls_gap: float = 2.0,
+        min_spread: float = 0.02,
+        ridge: float = 0.0,
     ):
         self.n_bins = n_bins
         self.bin_width = bin_width
@@ -166,10 +198,12 @@ class TLS(Learner):
         self.coef_order = coef_order
         self.min_bin_factor = min_bin_factor
         self.tls_gap = tls_gap
+        self.min_spread = min_spread
+        self.ridge = ridge
 
     # -- columns -------------------------------------------------------------------
     def _shape_columns(self, samples):
-        return list(RA_COLUMNS), []
+        return [], []
 
     def _output_columns(self):
         return list(VB_COLUMNS)
@@ -181,6 +215,8 @@ class TLS(Learner):
         co = check_int("coef_order", self.coef_order, 0, self.name)
         check_float("min_bin_factor", self.min_bin_factor, 1.0, self.name)
         check_float("tls_gap", self.tls_gap, 1.0, self.name, strict=True)
+        check_float("min_spread", self.min_spread, 0.0, self.name)
+        check_float("ridge", self.ridge, 0.0, self.name)
         if 2 * co + 1 > nb:
             raise ConfigError(
                 f"{self.name}: coef_order={co} needs n_bins >= {2 * co + 1}, got n_bins={nb}"
@@ -211,7 +247,7 @@ class TLS(Learner):
         phase = np.asarray(phase, dtype=float).ravel()
         th = self._coef_at(phase)
         m = self.gait_coef_.shape[1]
-        C = th[:, 0, :]
+        C = th[:, 0, :] + fourier.basis(phase, self.gait_order) @ self.mean_coef_
         B = th[:, 1 : 1 + m, :].transpose(0, 2, 1)
         A = th[:, 1 + m : 3 + m, :].transpose(0, 2, 1)
         dA = th[:, 3 + m :, :].reshape(len(phase), m, 2, -1).transpose(0, 3, 2, 1)
@@ -231,6 +267,11 @@ class TLS(Learner):
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
 
         self.gait_coef_ = fourier.fit(phase, r, self.gait_order)
+        # The phase mean of the outputs (order gait_order) is taken out before binning,
+        # so a bin's window only has to carry the residual's drift, not C's curvature.
+        self.mean_coef_ = fourier.fit(phase, Y, self.gait_order)
+        sy = Y.std(axis=0)  # outputs, like the regressors, scaled by their whole excursion
+        Y = Y - fourier.basis(phase, self.gait_order) @ self.mean_coef_
         delta, ddot = self._offsets(samples, r, dra)
         X = _features(delta, ddot)
         n, p = X.shape
@@ -244,6 +285,12 @@ class TLS(Learner):
         centres = np.arange(self.n_bins) * (_TWO_PI / self.n_bins)
         half = 0.5 * self.bin_width * _TWO_PI / self.n_bins
         wrapped = np.mod(phase, _TWO_PI)
+        # Regressors are scaled by the gait's own excursion (std of r and of dr_a/dt over
+        # the training data), not by their spread: delta is tiny when few cycles are
+        # seen, and inflating it to unit variance would hide that it is unidentifiable.
+        s_r = np.where(r.std(axis=0) > 0, r.std(axis=0), 1.0)
+        s_d = np.where(dra.std(axis=0) > 0, dra.std(axis=0), 1.0)
+        sx = np.concatenate([s_r, s_d, np.outer(s_r, s_d).ravel()])
         bin_coef = np.empty((self.n_bins, p + 1, q))
         n_kept = 0
         for b, c in enumerate(centres):
@@ -257,10 +304,16 @@ class TLS(Learner):
             # (the bin's coefficients are those at the centre, offset 0). A single bin
             # spans the whole circle, where an offset is meaningless.
             if self.n_bins > 1:
-                c0, Bm, kept = tls_solve(np.column_stack([X[idx], off[idx]]), Y[idx], self.tls_gap)
+                Xb = np.column_stack([X[idx], off[idx]])
+                sxb = np.append(sx, off[idx].std())
+                c0, Bm, kept = tls_solve(
+                    Xb, Y[idx], self.tls_gap, sxb, sy, self.min_spread, self.ridge
+                )
                 Bm = Bm[:-1]
             else:
-                c0, Bm, kept = tls_solve(X[idx], Y[idx], self.tls_gap)
+                c0, Bm, kept = tls_solve(
+                    X[idx], Y[idx], self.tls_gap, sx, sy, self.min_spread, self.ridge
+                )
             bin_coef[b, 0], bin_coef[b, 1:] = c0, Bm
             n_kept += kept
         self.bin_coef_ = bin_coef
@@ -274,7 +327,9 @@ class TLS(Learner):
         delta, ddot = self._offsets(samples, r, dra)
         X1 = np.hstack([np.ones((len(r), 1)), _features(delta, ddot)])
         th = self._coef_at(samples["phase"].to_numpy(dtype=float))
-        return np.einsum("np,npq->nq", X1, th)
+        phase = samples["phase"].to_numpy(dtype=float)
+        mean = fourier.basis(phase, self.gait_order) @ self.mean_coef_
+        return mean + np.einsum("np,npq->nq", X1, th)
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
@@ -309,9 +364,13 @@ class TLSSuds(TLS):
         coef_order: int = 3,
         min_bin_factor: float = 2.0,
         tls_gap: float = 2.0,
+        min_spread: float = 0.02,
+        ridge: float = 0.0,
         mode: str = "measured",
     ):
-        super().__init__(n_bins, bin_width, gait_order, coef_order, min_bin_factor, tls_gap)
+        super().__init__(
+            n_bins, bin_width, gait_order, coef_order, min_bin_factor, tls_gap, min_spread, ridge
+        )
         self.mode = mode
 
     def _validate(self):
@@ -337,6 +396,20 @@ class TLSSuds(TLS):
         r = r.copy()
         r[:, 2:] = self._rollout(samples, r, dra)
         return self._output_frame(self._predict_measured(samples, r, dra), samples)
+
+    def rollout(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """r_p integrated from each trial's first sample, columns rp_1..rp_k, input's index.
+
+        Uses phase, r_a, dr_a/dt of every sample and r_p of each trial's first sample only.
+        """
+        self._check_fitted()
+        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *self.rp_columns_)
+        require_columns(samples, need, self.name)
+        r = as_array(samples, list(RA_COLUMNS) + self.rp_columns_, self.name)
+        dra = as_array(samples, DRA_COLUMNS, self.name)
+        return pd.DataFrame(
+            self._rollout(samples, r, dra), index=samples.index, columns=self.rp_columns_
+        )
 
     def _rollout(self, samples, r, dra):
         """r_p integrated from each trial's first sample, shape (n, k), caller's order."""
