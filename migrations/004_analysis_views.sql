@@ -55,10 +55,13 @@ FROM results_labelled
 GROUP BY ALL;
 
 -- Spread table (the paper's IQR table): RMS error of vx by frequency, learner and number of
--- training cycles, over the pairs trained and tested at the same frequency.
+-- training cycles. `pairs` says which train/test pairs are pooled: 'same-condition' (same
+-- gait and frequency: the campaign's sample-efficiency sweep; what the report uses) or
+-- 'same-frequency' (any gaits at the same frequency).
 CREATE VIEW results_iqr AS
 SELECT
     campaign,
+    pairs,
     test_frequency_hz AS frequency_hz,
     model,
     n_cycles,
@@ -67,6 +70,11 @@ SELECT
     quantile_cont(rmse_vx, 0.5) AS median,
     quantile_cont(rmse_vx, 0.75) AS q3,
     quantile_cont(rmse_vx, 0.75) - quantile_cont(rmse_vx, 0.25) AS iqr
-FROM results_labelled
-WHERE freq_sim = 'same'
+FROM (
+    SELECT 'same-condition' AS pairs, * FROM results_labelled
+    WHERE freq_sim = 'same' AND gait_sim = 'same'
+    UNION ALL
+    SELECT 'same-frequency' AS pairs, * FROM results_labelled
+    WHERE freq_sim = 'same'
+) AS pooled
 GROUP BY ALL;

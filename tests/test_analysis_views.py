@@ -88,15 +88,20 @@ def test_views_work_from_a_plain_duckdb_connection(store):
     assert cats == 5 * 2 * 3  # learners x freq_sim x gait_sim (one training size)
 
 
-def test_iqr_view_agrees_with_the_python_table(store):
-    view = store.query_df("SELECT * FROM results_iqr WHERE campaign = 'grid'")
-    table = iqr_table(load_results(store, "grid"))
+@pytest.mark.parametrize("pairs", ["same-condition", "same-frequency"])
+def test_iqr_view_agrees_with_the_python_table(store, pairs):
+    view = store.query_df(
+        "SELECT * FROM results_iqr WHERE campaign = 'grid' AND pairs = ?", [pairs]
+    )
+    table = iqr_table(load_results(store, "grid"), pairs=pairs)
     merged = table.merge(
         view.assign(frequency_hz=view["frequency_hz"].round(6)),
         on=["frequency_hz", "model", "n_cycles"],
         suffixes=("", "_view"),
     )
     assert len(merged) == len(table) == len(view) == 3 * 5
+    # Per frequency and learner: 5 same-condition pairs, or 25 gait pairings.
+    assert (merged["n"] == {"same-condition": 5, "same-frequency": 25}[pairs]).all()
     for col in ("n", "q1", "median", "q3", "iqr"):
         np.testing.assert_allclose(merged[col], merged[f"{col}_view"], rtol=1e-12)
 

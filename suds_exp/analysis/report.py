@@ -31,20 +31,22 @@ def report_tables(
     n_cycles: int | None = None,
     paper_dir: Path | None = None,
     upper_from: int | None = None,
+    pairs: str = "same-condition",
 ) -> dict[str, pd.DataFrame]:
     """Every table of the report, from labelled results (see `load_results`).
 
     Keys: ``categories``, ``glm`` (100 ln scale), ``glm_rmse`` (mm/s), ``iqr``, ``slopes``,
     and, when the paper's tables are found (``paper_dir`` or the default), ``compare_glm``
     (both scales, column ``scale``), ``compare_iqr`` and ``agreement``. A part that the
-    results cannot support (no same-frequency pairs, say) is left out.
+    results cannot support (no same-condition pairs, say) is left out. ``pairs``: see
+    `iqr_table`.
     """
     tables: dict[str, pd.DataFrame] = {"categories": category_table(results, n_cycles)}
     tables["glm"] = glm_table(results, n_cycles, response="log")
     tables["glm_rmse"] = glm_table(results, n_cycles, response="rmse")
     try:
-        tables["iqr"] = iqr_table(results)
-        tables["slopes"] = slope_table(results, upper_from)
+        tables["iqr"] = iqr_table(results, pairs)
+        tables["slopes"] = slope_table(results, upper_from, pairs)
     except AnalysisError:
         pass
     try:
@@ -80,6 +82,11 @@ def iqr_wide(iqr: pd.DataFrame) -> dict[float, pd.DataFrame]:
     return out
 
 
+_PAIRS_TEXT = {
+    "same-condition": "Results trained and tested on the same condition (gait and frequency)",
+    "same-frequency": "Results trained and tested at the same frequency, gait pairings pooled",
+}
+
 _CSS = """
 body { font-family: sans-serif; max-width: 1400px; margin: 1em auto; padding: 0 1em; color: #222; }
 img { max-width: 100%; border: 1px solid #ddd; margin: 0.5em 0; }
@@ -106,6 +113,7 @@ def write_report(
     paper_dir: Path | None = None,
     n_cycles: int | None = None,
     upper_from: int | None = None,
+    pairs: str = "same-condition",
 ) -> Path:
     """Write the report of ``campaign`` into ``out_dir`` (default ``reports/<campaign>``).
 
@@ -126,6 +134,8 @@ def write_report(
         Training size of the box plots and GLMs (default the campaign's most common).
     upper_from : int, optional
         First training size of the slope fits (default the median size).
+    pairs : {"same-condition", "same-frequency"}
+        Train/test pairs of the spread table and sample-efficiency figure (see `iqr_table`).
 
     Returns
     -------
@@ -139,7 +149,7 @@ def write_report(
     results = load_results(store, campaign)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)
-    tables = report_tables(results, size, paper_dir, upper_from)
+    tables = report_tables(results, size, paper_dir, upper_from, pairs)
 
     figures = plots.category_boxplots(results, out, size)
     if "iqr" in tables:
@@ -159,13 +169,13 @@ def write_report(
             )
         files[name] = write_table(frame, out, name, digits.get(name, 2), md)
 
-    page = _page(campaign, store, results, size, tables, figures, files)
+    page = _page(campaign, store, results, size, tables, figures, files, pairs)
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")
     return index
 
 
-def _page(campaign, store, results, size, tables, figures, files) -> str:
+def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
     esc = html.escape
     glm = tables["glm"]
     refs = glm.attrs["reference"]
@@ -234,8 +244,8 @@ def _page(campaign, store, results, size, tables, figures, files) -> str:
     parts.append("<h2>3. Spread: IQR of RMS error of vx</h2>")
     if "iqr" in tables:
         parts.append(
-            '<p class="note">Results trained and tested at the same frequency, gait pairings '
-            "pooled, by learner (rows) and training cycles (columns); mm/s.</p>"
+            f'<p class="note">{_PAIRS_TEXT[pairs]}, by learner (rows) and training cycles '
+            "(columns); mm/s.</p>"
         )
         for freq, wide in iqr_wide(tables["iqr"]).items():
             parts += [f"<h3>{plots.frequency_name(freq)} Hz</h3>", to_html(wide, 2)]
@@ -252,8 +262,8 @@ def _page(campaign, store, results, size, tables, figures, files) -> str:
         ]
     else:
         parts.append(
-            "<p>No results trained and tested at the same frequency: no spread table "
-            "and no sample-efficiency figure.</p>"
+            f"<p>No results with {esc(pairs)} pairs: no spread table and no "
+            "sample-efficiency figure.</p>"
         )
 
     parts.append("<h2>5. Beside the paper</h2>")

@@ -1,8 +1,10 @@
 """Spread and sample efficiency: RMS error against the number of training cycles.
 
-Both tables use the results trained and tested at the same frequency (``freq_sim`` =
-``same``), all gait pairings pooled, and group them by that frequency, learner and
-``n_cycles`` - the paper's spread table and sample-efficiency figure, one per frequency.
+Both tables group results by test frequency, learner and ``n_cycles`` - the paper's
+spread table and sample-efficiency figure, one per frequency - over the train/test pairs
+named by ``pairs``: ``same-condition`` (same gait and frequency; the campaign's
+sample-efficiency sweep runs these, so every training size has the same mix of pairs) or
+``same-frequency`` (every gait pairing at one frequency).
 """
 
 from __future__ import annotations
@@ -14,13 +16,22 @@ from scipy.stats import t as student_t
 from suds_exp.analysis.categories import learner_order
 from suds_exp.analysis.errors import AnalysisError
 
+#: Which train/test pairs the spread and efficiency tables pool.
+PAIRS = {
+    "same-condition": lambda r: (r["freq_sim"] == "same") & (r["gait_sim"] == "same"),
+    "same-frequency": lambda r: r["freq_sim"] == "same",
+}
 
-def _same_frequency(results: pd.DataFrame) -> pd.DataFrame:
-    rows = results[results["freq_sim"] == "same"]
+
+def _pooled(results: pd.DataFrame, pairs: str) -> pd.DataFrame:
+    if pairs not in PAIRS:
+        raise AnalysisError(f"pairs {pairs!r}: expected one of {', '.join(PAIRS)}")
+    rows = results[PAIRS[pairs](results).fillna(False).astype(bool)]
     if rows.empty:
         raise AnalysisError(
-            "no results trained and tested at the same frequency; the spread table and "
-            "sample-efficiency figure need them"
+            f"no {pairs} results (trained and tested on the same "
+            f"{'condition' if pairs == 'same-condition' else 'frequency'}); the spread table "
+            "and sample-efficiency figure need them"
         )
     return rows.assign(frequency_hz=rows["test_frequency_hz"].round(6))
 
@@ -33,13 +44,15 @@ def _ordered(table: pd.DataFrame) -> pd.DataFrame:
     ).reset_index(drop=True)
 
 
-def iqr_table(results: pd.DataFrame) -> pd.DataFrame:
+def iqr_table(results: pd.DataFrame, pairs: str = "same-condition") -> pd.DataFrame:
     """Quartiles of the RMS error of vx by frequency, learner and training size.
 
     Parameters
     ----------
     results : DataFrame
         Rows of ``results_labelled`` (see `load_results`).
+    pairs : {"same-condition", "same-frequency"}
+        Train/test pairs pooled (see the module docstring).
 
     Returns
     -------
@@ -47,7 +60,7 @@ def iqr_table(results: pd.DataFrame) -> pd.DataFrame:
     ``median``, ``q3``, ``iqr`` (mm/s; linear-interpolated quartiles, as DuckDB's
     ``quantile_cont`` in the view ``results_iqr``).
     """
-    rows = _same_frequency(results)
+    rows = _pooled(results, pairs)
     grouped = rows.groupby(["frequency_hz", "model", "n_cycles"])["rmse_vx"]
     table = grouped.quantile([0.25, 0.5, 0.75]).unstack()
     table.columns = ["q1", "median", "q3"]
@@ -56,14 +69,16 @@ def iqr_table(results: pd.DataFrame) -> pd.DataFrame:
     return _ordered(table.reset_index())
 
 
-def slope_table(results: pd.DataFrame, upper_from: int | None = None) -> pd.DataFrame:
+def slope_table(
+    results: pd.DataFrame, upper_from: int | None = None, pairs: str = "same-condition"
+) -> pd.DataFrame:
     """Each learner's log-log slope of RMS error against training cycles, per frequency.
 
     The slope is the least-squares fit of ``ln(rmse_vx)`` on ``ln(n_cycles)`` over every
     result with ``n_cycles >= upper_from`` (so it is the rate at which the geometric-mean
     error falls; -0.5 is the rate of averaging out white noise). ``upper_from`` defaults
     to the median of the distinct training sizes: the upper half of the sweep, past the
-    first fast drop the paper describes.
+    first fast drop the paper describes. ``pairs`` as in `iqr_table`.
 
     Returns
     -------
@@ -71,7 +86,7 @@ def slope_table(results: pd.DataFrame, upper_from: int | None = None) -> pd.Data
     (95 %), ``cycles_from``, ``cycles_to``, ``n`` (results used); ``slope`` is NaN where
     fewer than two training sizes are in the range.
     """
-    rows = _same_frequency(results)
+    rows = _pooled(results, pairs)
     sizes = np.sort(rows["n_cycles"].unique())
     start = int(np.median(sizes)) if upper_from is None else int(upper_from)
     rows = rows[rows["n_cycles"] >= start]
@@ -102,5 +117,5 @@ def slope_table(results: pd.DataFrame, upper_from: int | None = None) -> pd.Data
             }
         )
     if not out:
-        raise AnalysisError(f"no same-frequency results with n_cycles >= {start}")
+        raise AnalysisError(f"no {pairs} results with n_cycles >= {start}")
     return _ordered(pd.DataFrame(out))
