@@ -1,0 +1,153 @@
+"""The work behind `suds-exp simulate`, `connection` and `effects` (the CLI only parses
+options and prints), plus the option parsers they share."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from fractions import Fraction
+from pathlib import Path
+
+import pandas as pd
+
+from suds_exp.errors import ConfigError
+from suds_exp.sim.config import SimConfig, load_config
+from suds_exp.sim.connection import local_connection, save_connection
+from suds_exp.sim.dataset import simulate_dataset
+from suds_exp.sim.effects import effect_library, set_effect
+from suds_exp.sim.gaits import FREQUENCIES_HZ, GAITS
+
+
+def parse_gaits(text: str | None) -> tuple[str, ...]:
+    """``"S+,O"`` -> ("S+", "O"); None -> all five gaits."""
+    if not text:
+        return GAITS
+    gaits = tuple(g.strip() for g in text.split(",") if g.strip())
+    bad = [g for g in gaits if g not in GAITS]
+    if bad or not gaits:
+        raise ConfigError(f"--gaits {text!r}: expected a comma list of {', '.join(GAITS)}")
+    return gaits
+
+
+def parse_freqs(text: str | None) -> tuple[float, ...]:
+    """``"1/3,0.5,1"`` -> (0.333.., 0.5, 1.0) Hz; None -> 1/3, 1/2, 1."""
+    if not text:
+        return FREQUENCIES_HZ
+    try:
+        freqs = tuple(float(Fraction(f.strip())) for f in text.split(",") if f.strip())
+    except (ValueError, ZeroDivisionError):
+        raise ConfigError(f"--freqs {text!r}: expected Hz values such as 1/3,0.5,1") from None
+    if not freqs or min(freqs) <= 0:
+        raise ConfigError(f"--freqs {text!r}: frequencies must be > 0 Hz")
+    return freqs
+
+
+def parse_cycles(text: str | None) -> tuple[int, int]:
+    """``"10:30"`` -> (10, 30); ``"12"`` -> (12, 12); None -> (10, 30)."""
+    if not text:
+        return (10, 30)
+    lo, _, hi = text.partition(":")
+    try:
+        lo_i = int(lo)
+        hi_i = int(hi) if hi else lo_i
+    except ValueError:
+        raise ConfigError(f"--cycles {text!r}: expected MIN:MAX, e.g. 10:30") from None
+    if not 1 <= lo_i <= hi_i:
+        raise ConfigError(f"--cycles {text!r}: expected 1 <= MIN <= MAX")
+    return lo_i, hi_i
+
+
+def build_config(config_path: Path | None, effects: Sequence[str] = ()) -> SimConfig:
+    """Nominal config, or the file's, with `NAME=VALUE` effect settings applied in order."""
+    cfg = load_config(config_path) if config_path is not None else SimConfig()
+    for assignment in effects:
+        cfg = set_effect(cfg, assignment)
+    return cfg
+
+
+def simulate_command(
+    out: Path,
+    config_path: Path | None = None,
+    gaits: str | None = None,
+    freqs: str | None = None,
+    repeats: int = 4,
+    cycles: str | None = None,
+    seed: int = 0,
+    effects: Sequence[str] = (),
+    store=None,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict:
+    """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary."""
+    cfg = build_config(config_path, effects)
+    start = time.perf_counter()
+    ds = simulate_dataset(
+        out,
+        cfg,
+        gaits=parse_gaits(gaits),
+        frequencies_hz=parse_freqs(freqs),
+        repeats=repeats,
+        cycles=parse_cycles(cycles),
+        seed=seed,
+        progress=progress,
+    )
+    wall = time.perf_counter() - start
+    summary = {
+        "out": str(out),
+        "manifest": str(ds.manifest),
+        "files": [str(p) for p in ds.tsv_paths],
+        "n_trials": len(ds.tsv_paths),
+        "simulated_seconds": round(float(ds.simulated_seconds), 3),
+        "wall_seconds": round(wall, 3),
+        "trial_ids": None,
+    }
+    if store is not None:
+        from suds_exp.ingest import ingest_paths
+
+        results = ingest_paths(store, [], manifest=ds.manifest, progress=False)
+        summary["trial_ids"] = [r.trial_id for r in results]
+    return summary
+
+
+def connection_command(
+    out: Path,
+    grid: int = 21,
+    half_range: float = 2.5,
+    geometry: str = "robot",
+    config_path: Path | None = None,
+    effects: Sequence[str] = (),
+    n_directions: int = 8,
+    figures: bool = True,
+) -> dict:
+    """Compute the local connection, write CSV (+ figures); a JSON-ready summary."""
+    cfg = build_config(config_path, effects)
+    conn = local_connection(grid, half_range, geometry, cfg, n_directions=n_directions)
+    written = save_connection(conn, out, figures=figures)
+    return {
+        "csv": str(written[0]),
+        "figures": [str(p) for p in written[1:]],
+        "geometry": geometry,
+        "grid": grid,
+        "range": half_range,
+        "length_unit": "mm" if geometry == "robot" else "total swimmer length",
+        "max_residual": conn.max_residual,
+    }
+
+
+def effects_table(config_path: Path | None = None, effects: Sequence[str] = ()) -> pd.DataFrame:
+    """One row per effect parameter: effect, state, parameter, unit, nominal, value, range."""
+    rows = []
+    for e in effect_library(build_config(config_path, effects)):
+        for p in e["parameters"]:
+            rows.append(
+                {
+                    "effect": e["name"],
+                    "state": e["state"],
+                    "nominal_state": e["nominal_state"],
+                    "parameter": p["name"] + (" *" if p["name"] == e["main"] else ""),
+                    "unit": p["unit"],
+                    "nominal": p["nominal"],
+                    "value": p["value"],
+                    "range": f"{p['range'][0]} .. {p['range'][1]}",
+                }
+            )
+    return pd.DataFrame(rows)
