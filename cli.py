@@ -126,6 +126,103 @@ def sql(
         console.print_frame(frame)
 
 
+EffectOption = Annotated[
+    list[str] | None,
+    typer.Option("--effect", help="NAME=VALUE (or NAME.PARAM=VALUE, on, off); repeatable."),
+]
+SimConfigOption = Annotated[
+    Path | None, typer.Option("--config", help="Simulator config (.toml or .json).")
+]
+
+
+@command()
+def simulate(
+    out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
+    config: SimConfigOption = None,
+    gaits: Annotated[str | None, typer.Option(help="Comma list, e.g. S+,O [all five].")] = None,
+    freqs: Annotated[str | None, typer.Option(help="Hz, comma list [1/3,1/2,1].")] = None,
+    repeats: Annotated[int, typer.Option(help="Trials per condition.")] = 4,
+    cycles: Annotated[str | None, typer.Option(help="Cycles per trial MIN:MAX [10:30].")] = None,
+    seed: Annotated[int, typer.Option(help="Same seed, same files.")] = 0,
+    effect: EffectOption = None,
+    ingest: Annotated[bool, typer.Option("--ingest", help="Ingest the result into --db.")] = False,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Simulate the swimmer and write QTM TSV captures, truth Parquet files and a manifest.
+
+    Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on
+    """
+    from suds_exp.progress import progress_bar
+    from suds_exp.sim.commands import parse_freqs, parse_gaits, simulate_command
+
+    n = len(parse_gaits(gaits)) * len(parse_freqs(freqs)) * repeats
+    with progress_bar("Simulating", total=n, enabled=not (quiet or json_)) as advance:
+        summary = simulate_command(
+            out,
+            config,
+            gaits,
+            freqs,
+            repeats,
+            cycles,
+            seed,
+            effect or [],
+            store=open_store(db) if ingest else None,
+            progress=lambda done, total: advance(),
+        )
+    if json_:
+        console.print_json(summary)
+    else:
+        console.out.print(
+            f"wrote {summary['n_trials']} trials ({summary['simulated_seconds']:.0f} s of robot "
+            f"time in {summary['wall_seconds']:.1f} s) and {summary['manifest']}"
+            + (f"; ingested trials {summary['trial_ids']}" if summary["trial_ids"] else "")
+        )
+
+
+@command()
+def connection(
+    out: Annotated[Path, typer.Option(help="CSV file; figures go beside it (_vx/_vy/_wz.png).")],
+    grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,
+    range_: Annotated[float, typer.Option("--range", help="Half range of phi1, phi2 (rad).")] = 2.5,
+    geometry: Annotated[str, typer.Option(help="robot or classic (3 equal links).")] = "robot",
+    config: SimConfigOption = None,
+    effect: EffectOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Local connection with flippers locked: body velocity per unit joint rate on a grid.
+
+    Example: suds-exp connection --out reports/connection.csv --geometry classic
+    """
+    from suds_exp.sim.commands import connection_command
+
+    summary = connection_command(out, grid, range_, geometry, config, effect or [])
+    if json_:
+        console.print_json(summary)
+    else:
+        console.out.print(f"wrote {summary['csv']} and {len(summary['figures'])} figures")
+
+
+@command()
+def effects(
+    config: SimConfigOption = None,
+    effect: EffectOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """List the simulator's named effects: parameters, units, nominal values, ranges.
+
+    Example: suds-exp effects --json
+    """
+    from suds_exp.sim import effect_library
+    from suds_exp.sim.commands import build_config, effects_table
+
+    if json_:
+        console.print_json(effect_library(build_config(config, effect or [])))
+    else:
+        console.print_frame(effects_table(config, effect or []), title="effects (* = main)")
+
+
 @command()
 def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
@@ -208,6 +305,36 @@ def status(
         console.print_json(report)
     else:
         print_status(report)
+
+
+@command()
+def report(
+    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    out: Annotated[Path | None, typer.Option(help="Folder [default: reports/NAME].")] = None,
+    cycles: Annotated[
+        int | None, typer.Option(help="Training size of box plots and GLMs [default: most common].")
+    ] = None,
+    pairs: Annotated[
+        str, typer.Option(help="Spread/efficiency pairs: same-condition or same-frequency.")
+    ] = "same-condition",
+    paper: Annotated[
+        Path | None, typer.Option(help="Folder of the paper's glm_table.csv and iqr_table.csv.")
+    ] = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Write a campaign's report: box plots, GLM, IQR and slope tables, paper comparison.
+
+    Example: suds-exp report paper --out reports/paper   (then open reports/paper/index.html)
+    """
+    from suds_exp.analysis import write_report
+
+    index = write_report(open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs)
+    if json_:
+        files = sorted(p.name for p in index.parent.iterdir() if p.is_file())
+        console.print_json({"index": str(index), "files": files})
+    else:
+        console.out.print(f"wrote {index}")
 
 
 if __name__ == "__main__":
