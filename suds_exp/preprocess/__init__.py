@@ -1,0 +1,26 @@
+"""Preprocessing: markers -> samples (cleaning, body frame, shape, PCA, Phaser, rates),
+stored as named, versioned parameter sets."""
+
+from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.preprocess.params import DEFAULTS, parse_param_items, resolve_params
+from suds_exp.preprocess.phaser import Phaser
+from suds_exp.preprocess.pipeline import (
+    PrepResult,
+    list_versions,
+    load_samples,
+    preprocess,
+    sample_columns,
+)
+
+__all__ = [
+    "DEFAULTS",
+    "Phaser",
+    "PrepResult",
+    "PreprocessError",
+    "list_versions",
+    "load_samples",
+    "parse_param_items",
+    "preprocess",
+    "resolve_params",
+    "sample_columns",
+]

@@ -1,0 +1,189 @@
+"""Step 2, body frame: the motion plane, the segment origins on the motor axes, the body pose.
+
+Following the paper's "Data Processing":
+
+- the XY plane is the least-squares plane of the rigid segment markers: the direction
+  along which every rigid marker keeps the most constant height over the trial (the
+  smallest principal axis of the pooled, per-marker-centred positions), with the mean
+  height of the four top-surface markers at Z = 0;
+- each outer segment gets a 2D frame from its two top-surface markers projected on that
+  plane; the segment origins are the points fixed in those frames whose distance to each
+  other stays constant (the motor axes, joined rigidly by the middle segment). They are
+  found by linear least squares on the squared-distance condition, refined by nonlinear
+  least squares on the distance itself;
+- the body origin is the midpoint of the two segment origins, +X from the tail origin to
+  the head origin, Z up.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from suds_exp.preprocess.errors import PreprocessError
+
+#: At most this many frames feed the nonlinear joint refinement (the linear start uses all).
+JOINT_FIT_FRAMES = 4000
+
+
+@dataclass(frozen=True)
+class Plane:
+    """The motion plane of a trial, in the capture's world frame.
+
+    Attributes
+    ----------
+    basis : array of shape (3, 3)
+        Rows are the plane frame's X, Y, Z axes in world coordinates (Z = plane normal,
+        pointing up; X = world X projected on the plane).
+    height_mm : float
+        World offset along the normal of the plane's Z = 0, mm.
+    """
+
+    basis: np.ndarray
+    height_mm: float
+
+    def project(self, xyz: np.ndarray) -> np.ndarray:
+        """World points (..., 3) mm -> plane coordinates (..., 3) mm."""
+        local = xyz @ self.basis.T
+        local[..., 2] -= self.height_mm
+        return local
+
+
+def fit_plane(rigid: np.ndarray, top: np.ndarray) -> Plane:
+    """Least-squares motion plane of a rigid-marker set.
+
+    Parameters
+    ----------
+    rigid : array of shape (n_frames, n_markers, 3), mm
+        Markers fixed on the segments (top-surface, spoke, back-edge), world frame.
+    top : array of shape (n_frames, n_top, 3), mm
+        The top-surface markers, whose mean height becomes Z = 0.
+    """
+    centred = rigid - rigid.mean(axis=0, keepdims=True)
+    flat = centred.reshape(-1, 3)
+    scatter = flat.T @ flat
+    _, vectors = np.linalg.eigh(scatter)
+    normal = vectors[:, 0]
+    if normal[2] < 0:
+        normal = -normal
+    x_axis = np.array([1.0, 0.0, 0.0]) - normal[0] * normal
+    if np.linalg.norm(x_axis) < 1e-6:  # plane perpendicular to world X: use world Y
+        x_axis = np.array([0.0, 1.0, 0.0]) - normal[1] * normal
+    x_axis /= np.linalg.norm(x_axis)
+    y_axis = np.cross(normal, x_axis)
+    basis = np.stack([x_axis, y_axis, normal])
+    height = float((top @ normal).mean())
+    return Plane(basis, height)
+
+
+@dataclass(frozen=True)
+class SegmentFrames:
+    """Per-frame 2D frames of the head and tail segments from their top-surface markers.
+
+    ``*_origin`` (n_frames, 2) mm: centroid of the segment's two top markers (plane XY);
+    ``*_angle`` (n_frames,) rad: heading of the line top_1 -> top_2.
+    """
+
+    head_origin: np.ndarray
+    head_angle: np.ndarray
+    tail_origin: np.ndarray
+    tail_angle: np.ndarray
+
+
+def segment_frames(head_top: np.ndarray, tail_top: np.ndarray) -> SegmentFrames:
+    """Frames from top markers, each array of shape (n_frames, 2, 2) (marker, plane XY) mm."""
+
+    def frame(top):
+        d = top[:, 1] - top[:, 0]
+        if np.any(np.hypot(d[:, 0], d[:, 1]) < 1e-6):
+            raise PreprocessError("a segment's two top-surface markers coincide")
+        return top.mean(axis=1), np.arctan2(d[:, 1], d[:, 0])
+
+    ho, ha = frame(head_top)
+    to, ta = frame(tail_top)
+    return SegmentFrames(ho, ha, to, ta)
+
+
+def _rot(angle: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate fixed 2-vector ``v`` by each angle: (n,) -> (n, 2)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1]], axis=-1)
+
+
+@dataclass(frozen=True)
+class Joints:
+    """Segment origins (motor axes) in the head and tail top-marker frames.
+
+    ``head`` and ``tail`` (2,) mm in their segment frames; ``length_mm`` their distance
+    (the middle segment's length); ``rms_mm`` the RMS of the distance's deviation.
+    """
+
+    head: np.ndarray
+    tail: np.ndarray
+    length_mm: float
+    rms_mm: float
+
+    def points(self, frames: SegmentFrames) -> tuple[np.ndarray, np.ndarray]:
+        """Head and tail segment origins per frame, each (n_frames, 2) mm in the plane."""
+        return (
+            frames.head_origin + _rot(frames.head_angle, self.head),
+            frames.tail_origin + _rot(frames.tail_angle, self.tail),
+        )
+
+
+def fit_joints(frames: SegmentFrames) -> Joints:
+    """Points fixed in the head and tail frames that keep a constant distance, mm."""
+    # Head frame expressed in the tail frame: relative offset p and angle psi.
+    d = frames.head_origin - frames.tail_origin
+    ta = frames.tail_angle
+    c, s = np.cos(ta), np.sin(ta)
+    p = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1)
+    psi = frames.head_angle - ta
+    cp, sp = np.cos(psi), np.sin(psi)
+    # |p + R(psi) a_h - a_t|^2 = L^2 is linear in (a_h, a_t, w1, w2, K) with
+    # w1 = a_t . a_h, w2 = a_t[1] a_h[0] - a_t[0] a_h[1], K = |a_h|^2 + |a_t|^2 - L^2.
+    rtp = np.stack([cp * p[:, 0] + sp * p[:, 1], -sp * p[:, 0] + cp * p[:, 1]], axis=1)
+    design = np.column_stack([2 * rtp, -2 * p, -2 * cp, -2 * sp, np.ones(len(p))])
+    rhs = -(p**2).sum(axis=1)
+    scale = np.abs(design).max(axis=0) + 1e-12
+    u, *_ = np.linalg.lstsq(design / scale, rhs, rcond=None)
+    u /= scale
+    gap = p + _rot(psi, u[:2]) - u[2:4]
+    start = np.concatenate([u[:4], [np.sqrt(np.mean(np.sum(gap**2, axis=1)))]])
+
+    step = max(1, len(p) // JOINT_FIT_FRAMES)
+    ps, cps, sps = p[::step], cp[::step], sp[::step]
+
+    def residual(x):
+        ah, at, length = x[:2], x[2:4], x[4]
+        jx = ps[:, 0] + cps * ah[0] - sps * ah[1] - at[0]
+        jy = ps[:, 1] + sps * ah[0] + cps * ah[1] - at[1]
+        return np.hypot(jx, jy) - length
+
+    fit = least_squares(residual, start, method="lm")
+    if not fit.success and fit.status <= 0:
+        raise PreprocessError(f"segment origins: least squares did not converge ({fit.message})")
+    ah, at = fit.x[:2], fit.x[2:4]
+    dist = np.hypot(*(p + _rot(psi, ah) - at).T)
+    return Joints(ah, at, float(np.mean(dist)), float(np.sqrt(np.mean((dist - dist.mean()) ** 2))))
+
+
+@dataclass(frozen=True)
+class BodyPose:
+    """Body frame per frame: ``xy`` (n_frames, 2) mm in the plane, ``heading`` (n_frames,)
+    rad unwrapped; ``head_joint``/``tail_joint`` (n_frames, 2) mm, the segment origins."""
+
+    xy: np.ndarray
+    heading: np.ndarray
+    head_joint: np.ndarray
+    tail_joint: np.ndarray
+
+
+def body_pose(frames: SegmentFrames, joints: Joints) -> BodyPose:
+    """Body origin = midpoint of the segment origins, +X = tail origin -> head origin."""
+    head, tail = joints.points(frames)
+    axis = head - tail
+    heading = np.unwrap(np.arctan2(axis[:, 1], axis[:, 0]))
+    return BodyPose(0.5 * (head + tail), heading, head, tail)

@@ -1,0 +1,125 @@
+"""Preprocessing parameters: defaults, `KEY=VALUE` parsing, validation and the version hash.
+
+A preprocessing version is its parameter set: the full set (defaults filled in) is stored
+as canonical JSON and its SHA-256 names the version, so the same parameters always give
+the same version and any changed value gives a new one.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+from suds_exp.errors import ConfigError
+
+#: Every parameter, its default and meaning (units in the name or the text).
+DEFAULTS: dict[str, Any] = {
+    # cleaning
+    "jump_mm": 9.0,  # a frame-to-frame marker step longer than this is a jump, mm
+    "max_gap_s": 0.25,  # refuse a trial whose longest gap to fill exceeds this, s
+    # body frame
+    "joint_fit": "version",  # segment origins fitted over all trials of the version | per trial
+    # shape
+    "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
+    "shape_polyorder": 5,  # its polynomial order
+    "k": 4,  # number of passive principal components kept as r_p (1..12)
+    # phase (Phaser, Revzen & Guckenheimer 2008)
+    "phaser_order": 10,  # order of the Fourier-series corrections
+    "phaser_group": "condition",  # trials that share one trained Phaser: condition|gait|trial|all
+    "phaser_channels": "ra",  # signals the phase is estimated from: ra | ra+rp
+    "phaser_pad_cycles": 2.0,  # periodic padding at each end against Hilbert edge effects, cycles
+    # rates (Savitzky-Golay differentiator)
+    "sg_window_s": 0.21,  # window length, s (rounded to an odd number of frames)
+    "sg_polyorder": 3,  # polynomial order
+}
+
+JOINT_FITS = ("version", "trial")
+PHASER_GROUPS = ("condition", "gait", "trial", "all")
+PHASER_CHANNELS = ("ra", "ra+rp")
+MAX_K = 12
+
+
+def _coerce(key: str, value: Any) -> Any:
+    default = DEFAULTS[key]
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise ConfigError(f"--param {key}: expected text, got {value!r}")
+        return value
+    if isinstance(value, bool):
+        raise ConfigError(f"--param {key}: expected a number, got {value!r}")
+    if isinstance(value, str):
+        try:
+            value = float(value)
+        except ValueError:
+            raise ConfigError(f"--param {key}={value}: expected a number") from None
+    if not isinstance(value, int | float):
+        raise ConfigError(f"--param {key}: expected a number, got {value!r}")
+    if isinstance(default, int):
+        if value != int(value):
+            raise ConfigError(f"--param {key}={value}: expected a whole number")
+        return int(value)
+    return float(value)
+
+
+def _check(params: dict[str, Any]) -> None:
+    positive = ("jump_mm", "max_gap_s", "sg_window_s", "phaser_order")
+    for key in positive:
+        if not params[key] > 0:
+            raise ConfigError(f"--param {key}={params[key]}: must be > 0")
+    for key in ("phaser_pad_cycles", "shape_window_s"):
+        if params[key] < 0:
+            raise ConfigError(f"--param {key}={params[key]}: must be >= 0")
+    if not 1 <= params["k"] <= MAX_K:
+        raise ConfigError(f"--param k={params['k']}: must be between 1 and {MAX_K}")
+    for key in ("sg_polyorder", "shape_polyorder"):
+        if not 1 <= params[key] <= 6:
+            raise ConfigError(f"--param {key}={params[key]}: must be 1..6")
+    for key, choices in (
+        ("joint_fit", JOINT_FITS),
+        ("phaser_group", PHASER_GROUPS),
+        ("phaser_channels", PHASER_CHANNELS),
+    ):
+        if params[key] not in choices:
+            raise ConfigError(f"--param {key}={params[key]}: expected one of {', '.join(choices)}")
+
+
+def resolve_params(given: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The full parameter set: ``given`` over `DEFAULTS`, typed and validated.
+
+    Raises `ConfigError` for an unknown key or a value of the wrong type or range.
+    """
+    params = dict(DEFAULTS)
+    for key, value in (given or {}).items():
+        if key not in DEFAULTS:
+            raise ConfigError(
+                f"--param {key}: unknown parameter; expected one of {', '.join(DEFAULTS)}"
+            )
+        params[key] = _coerce(key, value)
+    _check(params)
+    return params
+
+
+def parse_param_items(items: Iterable[str]) -> dict[str, str]:
+    """``["k=3", "jump_mm=12"]`` -> ``{"k": "3", "jump_mm": "12"}`` (values still text)."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise ConfigError(f"--param {item!r}: expected KEY=VALUE, e.g. --param k=3")
+        if key in out:
+            raise ConfigError(f"--param {key}: given twice")
+        out[key] = value
+    return out
+
+
+def params_json(params: Mapping[str, Any]) -> str:
+    """Canonical JSON of a resolved parameter set (sorted keys, no spaces)."""
+    return json.dumps(dict(params), sort_keys=True, separators=(",", ":"))
+
+
+def params_hash(params: Mapping[str, Any]) -> str:
+    """SHA-256 (hex) of the canonical JSON: the identity of a preprocessing version."""
+    return hashlib.sha256(params_json(params).encode()).hexdigest()

@@ -1,0 +1,574 @@
+"""`preprocess`: markers -> samples as a stored, versioned parameter set; `load_samples`.
+
+A run resolves its version (same parameters = same version), reads the markers of the
+trials not yet done, cleans them and measures their geometry (any refused trial stops the
+run before anything is written), fits what the version lacks (segment origins, passive
+PCA, one Phaser per trial group) on those trials and stores it, then writes each trial's
+samples with its stats in one transaction. An interrupted run therefore resumes with the
+trials not yet done, reusing the stored fit.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import sqlalchemy as sa
+
+from suds_exp.ingest.layout import ROLES, trial_layout
+from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
+from suds_exp.preprocess.clean import CleanResult, clean_tracks
+from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
+from suds_exp.preprocess.params import params_hash, params_json, resolve_params
+from suds_exp.preprocess.phaser import Phaser, cycles
+from suds_exp.preprocess.rates import body_velocity, derivative, smooth, window_frames
+from suds_exp.preprocess.shape import PassivePCA
+from suds_exp.preprocess.tables import (
+    DRP_COLUMNS,
+    RP_COLUMNS,
+    prep_fits,
+    prep_pca,
+    prep_trials,
+    prep_versions,
+)
+from suds_exp.progress import progress_bar
+from suds_exp.store import Store
+from suds_exp.store.tables import trials
+
+#: Trials whose samples are written in one transaction (resume granularity).
+WRITE_BATCH_FRAMES = 50_000
+
+
+@dataclass
+class PrepResult:
+    """What a `preprocess` run did.
+
+    ``processed``/``skipped``: trial ids written now / already done before;
+    ``explained_variance_ratio``: of the k kept passive components (fraction each).
+    """
+
+    version_id: int
+    name: str
+    params_hash: str
+    params: dict
+    created: bool
+    processed: list[int] = field(default_factory=list)
+    skipped: list[int] = field(default_factory=list)
+    explained_variance_ratio: list[float] = field(default_factory=list)
+    n_samples: int = 0
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass
+class _Trial:
+    """One trial in flight: metadata, cleaned tracks, measured geometry, kinematics."""
+
+    id: int
+    label: str
+    group: str
+    rate_hz: float
+    frequency_hz: float | None
+    frame: np.ndarray
+    t: np.ndarray
+    clean: CleanResult
+    measured: Measured
+    kin: Kinematics | None = None
+
+
+# -- versions -----------------------------------------------------------------------------
+def _find_version(conn: sa.Connection, version: int | str) -> sa.Row:
+    v = prep_versions.c
+    if isinstance(version, int | np.integer) or (isinstance(version, str) and version.isdigit()):
+        row = conn.execute(sa.select(prep_versions).where(v.id == int(version))).first()
+    else:
+        row = conn.execute(sa.select(prep_versions).where(v.name == version)).first()
+        if row is None and len(version) >= 6:
+            found = conn.execute(
+                sa.select(prep_versions).where(v.params_hash.startswith(version))
+            ).fetchall()
+            row = found[0] if len(found) == 1 else None
+    if row is None:
+        known = conn.execute(sa.select(v.id, v.name).order_by(v.id)).fetchall()
+        listing = ", ".join(f"{r.id} ({r.name})" for r in known) or "none yet"
+        raise PreprocessError(
+            f"preprocessing version {version!r} not found; known versions: {listing}"
+        )
+    return row
+
+
+def _group_key(kind: str, trial_id: int, gait: str | None, frequency_hz: float | None) -> str:
+    if kind == "all":
+        return "all"
+    if kind == "trial" or gait is None:
+        return f"trial:{trial_id}"
+    if kind == "gait":
+        return gait
+    return f"{gait}@{round(float(frequency_hz), 6):g}"
+
+
+# -- reading ------------------------------------------------------------------------------
+def _read_tracks(conn: sa.Connection, meta: pd.DataFrame) -> dict[int, tuple]:
+    """trial id -> (frame (n,), t (n,), xyz (n, 11, 3) in ROLES order, NaN = missing).
+
+    Trials sharing a marker layout are read in one query that maps marker names to role
+    numbers in SQL, so only numbers cross into Python.
+    """
+    out = {}
+    by_layout: dict[tuple[str, ...], list[int]] = {}
+    for tid, stored in zip(meta.id, meta.layout, strict=True):
+        layout = trial_layout(stored if isinstance(stored, str) else None)
+        by_layout.setdefault(tuple(layout[r] for r in ROLES), []).append(int(tid))
+    for names, ids in by_layout.items():
+        df = Store.frame(
+            conn,
+            "SELECT trial_id, frame, t, list_position($names, marker) - 1 AS role, x, y, z "
+            "FROM markers WHERE trial_id IN (SELECT unnest($ids::INTEGER[])) "
+            "AND list_contains($names, marker) ORDER BY trial_id, frame, role",
+            {"names": list(names), "ids": ids},
+        )
+        tid_col = df.trial_id.to_numpy()
+        bounds = np.searchsorted(tid_col, ids + [np.iinfo(np.int32).max], side="left")
+        for j, tid in enumerate(ids):
+            part = df.iloc[bounds[j] : bounds[j + 1]]
+            role = part.role.to_numpy()
+            present = np.unique(role)
+            if len(present) < len(ROLES):
+                lacking = [ROLES[i] for i in range(len(ROLES)) if i not in set(present)]
+                raise PreprocessError(
+                    f"trial {tid}: has no marker for role(s) {', '.join(lacking)}; "
+                    "re-ingest it with a --layout naming them"
+                )
+            values = part[["x", "y", "z"]].to_numpy(dtype=float)
+            frame_col = part.frame.to_numpy()
+            n = len(part) // len(ROLES)
+            if len(part) == n * len(ROLES) and np.array_equal(
+                role, np.tile(np.arange(len(ROLES)), n)
+            ):
+                xyz = values.reshape(n, len(ROLES), 3)
+                frames = frame_col[:: len(ROLES)]
+                t = part.t.to_numpy()[:: len(ROLES)]
+            else:  # a frame lacks some marker rows: scatter
+                frames, inverse = np.unique(frame_col, return_inverse=True)
+                xyz = np.full((len(frames), len(ROLES), 3), np.nan)
+                xyz[inverse, role] = values
+                t = np.zeros(len(frames))
+                t[inverse] = part.t.to_numpy()
+            out[tid] = (frames, t, xyz)
+    return out
+
+
+def _trial_meta(conn: sa.Connection, wanted: list[int] | None) -> pd.DataFrame:
+    query = sa.select(
+        trials.c.id,
+        trials.c.source_file,
+        trials.c.gait,
+        trials.c.frequency_hz,
+        trials.c.sample_rate_hz,
+        trials.c.n_frames,
+        trials.c.layout,
+    ).order_by(trials.c.id)
+    meta = Store.frame(conn, query)
+    if wanted is not None:
+        unknown = sorted(set(wanted) - set(int(i) for i in meta.id))
+        if unknown:
+            raise PreprocessError(
+                f"--trials: no trial with id {', '.join(map(str, unknown))}; see `suds-exp trials`"
+            )
+        meta = meta[meta.id.isin(wanted)]
+    return meta.reset_index(drop=True)
+
+
+# -- per-trial computation ------------------------------------------------------------------
+def _prepare(meta_row, tracks, params: dict) -> _Trial:
+    tid = int(meta_row.id)
+    label = f"trial {tid} ({meta_row.source_file})"
+    frame, t, xyz = tracks
+    rate = float(meta_row.sample_rate_hz)
+    if len(frame) < 8:
+        raise PreprocessError(f"{label}: only {len(frame)} frames; need at least 8")
+    max_gap = int(np.floor(params["max_gap_s"] * rate + 1e-9))
+    try:
+        cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in ROLES])
+        measured = measure(cleaned.xyz)
+    except PreprocessError as exc:
+        raise PreprocessError(f"{label}: {exc}") from None
+    gait = meta_row.gait if isinstance(meta_row.gait, str) else None
+    freq = None if pd.isna(meta_row.frequency_hz) else float(meta_row.frequency_hz)
+    group = _group_key(params["phaser_group"], tid, gait, freq)
+    return _Trial(tid, label, group, rate, freq, frame, t, cleaned, measured)
+
+
+def _concat_frames(items: list[_Trial]) -> SegmentFrames:
+    return SegmentFrames(
+        *[
+            np.concatenate([getattr(tr.measured.frames, a) for tr in items])
+            for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
+        ]
+    )
+
+
+def _phaser_input(tr: _Trial, pca: PassivePCA, params: dict) -> np.ndarray:
+    ra, passive = _smoothed(tr, params)
+    if params["phaser_channels"] == "ra+rp":
+        return np.column_stack([ra, pca.transform(passive)])
+    return ra
+
+
+def _smoothed(tr: _Trial, params: dict) -> tuple[np.ndarray, np.ndarray]:
+    w = window_frames(params["shape_window_s"], tr.rate_hz, params["shape_polyorder"], len(tr.t))
+    return smooth(tr.kin.ra, w, params["shape_polyorder"]), smooth(
+        tr.kin.passive, w, params["shape_polyorder"]
+    )
+
+
+def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser, params: dict):
+    k = params["k"]
+    dt = 1.0 / tr.rate_hz
+    ra, passive = _smoothed(tr, params)
+    w = window_frames(params["sg_window_s"], tr.rate_hz, params["sg_polyorder"], len(tr.t))
+    po = params["sg_polyorder"]
+    dra = derivative(tr.kin.ra, dt, w, po)
+    drp = pca.transform_rate(derivative(tr.kin.passive, dt, w, po))
+    rp = pca.transform(passive)
+    vb = body_velocity(tr.kin.xy, tr.kin.heading, dt, w, po)
+    phase = phaser.transform(_phaser_input(tr, pca, params))
+    n = len(tr.t)
+    cols: dict[str, Any] = {
+        "version_id": np.full(n, version_id, dtype=np.int32),
+        "trial_id": np.full(n, tr.id, dtype=np.int32),
+        "frame": tr.frame.astype(np.int32),
+        "t": tr.t,
+        "phase": phase,
+        "cycle": cycles(phase).astype(np.int32),
+        "ra_1": ra[:, 0],
+        "ra_2": ra[:, 1],
+        "dra_1": dra[:, 0],
+        "dra_2": dra[:, 1],
+    }
+    for i in range(len(RP_COLUMNS)):
+        cols[RP_COLUMNS[i]] = rp[:, i] if i < k else np.full(n, np.nan)
+        cols[DRP_COLUMNS[i]] = drp[:, i] if i < k else np.full(n, np.nan)
+    cols.update(vx=vb[:, 0], vy=vb[:, 1], wz=vb[:, 2])
+    return pd.DataFrame(cols)
+
+
+def _stats_row(tr: _Trial, version_id: int, joints: Joints) -> dict:
+    c = tr.clean
+    return {
+        "version_id": version_id,
+        "trial_id": tr.id,
+        "n_frames": len(tr.t),
+        "n_jumps": c.n_jumps,
+        "removed_fraction": c.removed_fraction,
+        "filled_fraction": c.filled_fraction,
+        "longest_gap_frames": c.longest_gap,
+        "plane_normal": tr.measured.plane.basis[2].tolist(),
+        "middle_length_mm": joints.length_mm,
+        "joint_rms_mm": joints.rms_mm,
+        "phaser_group": tr.group,
+        "done_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
+    }
+
+
+def _joints_state(j: Joints) -> str:
+    return json.dumps(
+        {
+            "head": j.head.tolist(),
+            "tail": j.tail.tolist(),
+            "length_mm": j.length_mm,
+            "rms_mm": j.rms_mm,
+        }
+    )
+
+
+def _joints_from(state: str) -> Joints:
+    d = json.loads(state)
+    return Joints(np.asarray(d["head"]), np.asarray(d["tail"]), d["length_mm"], d["rms_mm"])
+
+
+def _fit_row(version_id, kind, grp, state, items: list[_Trial]) -> dict:
+    return {
+        "version_id": version_id,
+        "kind": kind,
+        "grp": grp,
+        "state": state,
+        "trial_ids": [tr.id for tr in items],
+        "n_frames": int(sum(len(tr.t) for tr in items)),
+        "fitted_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
+    }
+
+
+# -- the run ------------------------------------------------------------------------------
+def preprocess(
+    store: Store,
+    name: str | None = None,
+    params: Mapping[str, Any] | None = None,
+    trials: Iterable[int] | None = None,
+    progress: bool = True,
+) -> PrepResult:
+    """Create or reuse the preprocessing version of ``params`` and fill its samples.
+
+    Parameters
+    ----------
+    store : Store
+    name : str, optional
+        Name of a new version (default ``v<id>``); a version with the same parameters is
+        reused whatever its name. A name already used by other parameters is refused.
+    params : mapping, optional
+        Parameters over `suds_exp.preprocess.params.DEFAULTS` (values may be text).
+    trials : iterable of int, optional
+        Trial ids to process (default: every trial in the store).
+    progress : bool
+        Show progress bars on stderr.
+
+    Returns
+    -------
+    PrepResult
+
+    Raises `PreprocessError` (nothing written) for a trial that cannot be used, e.g. a
+    gap longer than ``max_gap_s``; `ConfigError` for a bad parameter.
+    """
+    started = time.perf_counter()
+    params = resolve_params(params)
+    digest = params_hash(params)
+    wanted = None if trials is None else sorted({int(i) for i in trials})
+    v = prep_versions.c
+    with store.write() as conn:
+        row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
+        if row is None and name is not None:
+            clash = conn.execute(sa.select(v.id).where(v.name == name)).first()
+            if clash is not None:
+                raise PreprocessError(
+                    f"--name {name}: version {clash.id} already has that name with other "
+                    "parameters; choose another name"
+                )
+        meta = _trial_meta(conn, wanted)
+        done: set[int] = set()
+        fits: dict[tuple[str, str], str] = {}
+        if row is not None:
+            done = {
+                int(r[0])
+                for r in conn.execute(
+                    sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == row.id)
+                )
+            }
+            fits = {
+                (r.kind, r.grp): r.state
+                for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == row.id))
+            }
+        todo_meta = meta[~meta.id.isin(done)]
+        tracks = _read_tracks(conn, todo_meta) if len(todo_meta) else {}
+    skipped = sorted(int(i) for i in meta.id if int(i) in done)
+    if meta.empty:
+        raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+
+    # pass 1: clean and measure every trial to do; any refusal stops before writing
+    items: list[_Trial] = []
+    with progress_bar("Cleaning", total=len(todo_meta), enabled=progress) as advance:
+        for meta_row in todo_meta.itertuples(index=False):
+            items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params))
+            advance()
+
+    result = PrepResult(
+        version_id=row.id if row is not None else -1,
+        name=row.name if row is not None else (name or ""),
+        params_hash=digest,
+        params=params,
+        created=row is None,
+        skipped=skipped,
+    )
+    if not items:
+        result.explained_variance_ratio = _kept_ratio(store, result.version_id, params["k"])
+        result.seconds = time.perf_counter() - started
+        return result
+
+    # fits the version lacks, on the trials of this run
+    new_fits: list[dict] = []
+    if params["joint_fit"] == "version":
+        if ("joints", "") in fits:
+            shared = _joints_from(fits[("joints", "")])
+        else:
+            shared = fit_joints(_concat_frames(items))
+            new_fits.append(("joints", "", _joints_state(shared), items))
+        joints = {tr.id: shared for tr in items}
+    else:
+        joints = {tr.id: fit_joints(tr.measured.frames) for tr in items}
+    for tr in items:
+        tr.kin = kinematics(tr.measured, joints[tr.id])
+    if ("pca", "") in fits:
+        pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
+    else:
+        pca = PassivePCA(params["k"]).fit(
+            np.concatenate([_smoothed(tr, params)[1] for tr in items])
+        )
+        new_fits.append(("pca", "", json.dumps(pca.to_dict()), items))
+    phasers: dict[str, Phaser] = {}
+    for group in sorted({tr.group for tr in items}):
+        if ("phaser", group) in fits:
+            phasers[group] = Phaser.from_dict(json.loads(fits[("phaser", group)]))
+            continue
+        members = [tr for tr in items if tr.group == group]
+        try:
+            phasers[group] = Phaser(params["phaser_order"], params["phaser_pad_cycles"]).fit(
+                [_phaser_input(tr, pca, params) for tr in members]
+            )
+        except PreprocessError as exc:
+            raise PreprocessError(f"phase of trial group {group}: {exc}") from None
+        new_fits.append(("phaser", group, json.dumps(phasers[group].to_dict()), members))
+
+    # the version row and its new fits, in one transaction
+    with store.write() as conn:
+        if row is None:
+            vid = int(conn.exec_driver_sql("SELECT nextval('prep_versions_id_seq')").scalar_one())
+            name = name or f"v{vid}"
+            conn.execute(
+                sa.insert(prep_versions).values(
+                    id=vid,
+                    name=name,
+                    params_hash=digest,
+                    params=params_json(params),
+                    k=params["k"],
+                    created_at=sa.func.current_timestamp(),
+                )
+            )
+            result.version_id, result.name = vid, name
+        vid = result.version_id
+        if new_fits:
+            store.insert_df(
+                conn,
+                prep_fits.name,
+                pd.DataFrame(
+                    [
+                        _fit_row(vid, kind, grp, state, members)
+                        for kind, grp, state, members in new_fits
+                    ]
+                ),
+            )
+        if any(kind == "pca" for kind, *_ in new_fits):
+            cum = np.cumsum(pca.explained_variance_ratio_)
+            store.insert_df(
+                conn,
+                prep_pca.name,
+                pd.DataFrame(
+                    {
+                        "version_id": vid,
+                        "component": np.arange(1, len(cum) + 1),
+                        "explained_variance": pca.explained_variance_,
+                        "explained_variance_ratio": pca.explained_variance_ratio_,
+                        "cumulative_ratio": cum,
+                        "kept": np.arange(len(cum)) < params["k"],
+                        "loadings": [list(r) for r in pca.components_],
+                    }
+                ),
+            )
+
+    # pass 2: phase, rates, samples; each batch of trials in one transaction
+    with progress_bar("Preprocessing", total=len(items), enabled=progress) as advance:
+        batch: list[_Trial] = []
+        for i, tr in enumerate(items):
+            batch.append(tr)
+            if sum(len(b.t) for b in batch) >= WRITE_BATCH_FRAMES or i == len(items) - 1:
+                frames = [_samples_frame(b, vid, pca, phasers[b.group], params) for b in batch]
+                stats = pd.DataFrame([_stats_row(b, vid, joints[b.id]) for b in batch])
+                with store.write() as conn:
+                    store.insert_df(conn, "samples", pd.concat(frames, ignore_index=True))
+                    store.insert_df(conn, prep_trials.name, stats)
+                result.processed.extend(b.id for b in batch)
+                result.n_samples += sum(len(f) for f in frames)
+                advance(len(batch))
+                batch = []
+    result.explained_variance_ratio = pca.explained_variance_ratio_[: params["k"]].tolist()
+    result.seconds = time.perf_counter() - started
+    return result
+
+
+def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
+    frame = store.query_df(
+        "SELECT explained_variance_ratio FROM prep_pca WHERE version_id = ? AND kept "
+        "ORDER BY component",
+        [version_id],
+    )
+    return frame.explained_variance_ratio.tolist()[:k]
+
+
+# -- reading samples ----------------------------------------------------------------------
+def sample_columns(k: int) -> list[str]:
+    """The standard samples columns for k passive components, in order."""
+    return [
+        "trial_id",
+        "frame",
+        "t",
+        "phase",
+        "cycle",
+        "ra_1",
+        "ra_2",
+        "dra_1",
+        "dra_2",
+        *RP_COLUMNS[:k],
+        *DRP_COLUMNS[:k],
+        "vx",
+        "vy",
+        "wz",
+    ]
+
+
+def load_samples(
+    store: Store, version: int | str, trials: Iterable[int] | None = None
+) -> pd.DataFrame:
+    """The samples of a preprocessing version, ordered by trial and frame.
+
+    Parameters
+    ----------
+    store : Store
+    version : int or str
+        Version id, name, or a unique prefix (>= 6 characters) of its parameter hash.
+    trials : iterable of int, optional
+        Only these trial ids.
+
+    Returns
+    -------
+    DataFrame with columns ``trial_id, frame, t (s), phase (rad, unwrapped), cycle,
+    ra_1, ra_2 (rad), dra_1, dra_2 (rad/s), rp_1..rp_k (mm), drp_1..drp_k (mm/s),
+    vx, vy (mm/s), wz (rad/s)`` (body frame) and the trial's ``gait``, ``frequency_hz``.
+    """
+    with store.read() as conn:
+        row = _find_version(conn, version)
+        cols = sample_columns(row.k)
+        select = ", ".join(f's."{c}"' for c in cols)
+        where = "s.version_id = ?"
+        args: list[Any] = [row.id]
+        if trials is not None:
+            ids = sorted({int(i) for i in trials})
+            where += f" AND s.trial_id IN ({', '.join('?' * len(ids))})" if ids else " AND false"
+            args += ids
+        return Store.frame(
+            conn,
+            f"SELECT {select}, t.gait, t.frequency_hz FROM samples s "
+            f"JOIN trials t ON t.id = s.trial_id WHERE {where} ORDER BY s.trial_id, s.frame",
+            args,
+        )
+
+
+def list_versions(store: Store) -> pd.DataFrame:
+    """One row per version: id, name, params_hash, k, trials done, samples, created_at,
+    kept explained variance (fraction)."""
+    return store.query_df(
+        """
+        SELECT v.id, v.name, v.params_hash, v.k,
+               (SELECT count(*) FROM prep_trials p WHERE p.version_id = v.id) AS n_trials,
+               (SELECT count(*) FROM samples s WHERE s.version_id = v.id) AS n_samples,
+               (SELECT sum(explained_variance_ratio) FROM prep_pca c
+                 WHERE c.version_id = v.id AND c.kept) AS explained_variance_kept,
+               v.created_at, v.params
+        FROM prep_versions v ORDER BY v.id
+        """
+    )

@@ -1,0 +1,227 @@
+"""Synthetic captures of a rigid 3-segment robot with known truth (tests, benchmarks).
+
+Kinematics only (no physics): the gait drives phi1, phi2 exactly as commanded, the body
+follows a prescribed smooth body velocity, and the flippers open and close with the
+phase. Markers sit on rigid segments at fixed places (different from the simulator's, so
+nothing downstream can rely on one particular placement), the motion plane is tilted
+and offset in the capture volume, and the tracks get noise, jumps and dropouts. The truth
+frame has the simulator truth file's columns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.integrate import cumulative_trapezoid
+from scipy.spatial.transform import Rotation
+
+from suds_exp.ingest.layout import ROLES
+
+MIDDLE_MM = 100.0
+#: Marker positions in their segment frame (origin at the segment's joint, X along the
+#: segment pointing tail-to-head, Y left, Z up from the bed), mm.
+RIGID = {
+    "head_top_1": ("head", (35.0, 10.0, 55.0)),
+    "head_top_2": ("head", (75.0, -10.0, 55.0)),
+    "head_spoke": ("head", (55.0, 8.0, 140.0)),
+    "tail_top_1": ("tail", (-35.0, 10.0, 55.0)),
+    "tail_top_2": ("tail", (-75.0, -10.0, 55.0)),
+    "tail_spoke": ("tail", (-55.0, -8.0, 140.0)),
+    "tail_back": ("tail", (-110.0, 0.0, 15.0)),
+}
+#: Flipper hinges (segment, hinge x, side) and marker distance from the hinge, mm.
+FLIPPERS = {
+    "flipper_1": ("head", 80.0, 1.0),
+    "flipper_2": ("head", 80.0, -1.0),
+    "flipper_3": ("tail", -30.0, 1.0),
+    "flipper_4": ("tail", -30.0, -1.0),
+}
+HALF_WIDTH_MM = 20.0
+FLIPPER_MARKER_MM = 30.0
+FLIPPER_HEIGHT_MM = 30.0
+
+_GAIT_K = {"S+": -4.0, "S-": -9.0, "O": np.inf, "D-": 9.0, "D+": 4.0}
+
+
+def gait_shape(gait: str, theta: np.ndarray) -> np.ndarray:
+    """Commanded (phi1, phi2) of a gait at phases ``theta``: (n,) rad -> (n, 2) rad."""
+    k = _GAIT_K[gait]
+    return np.column_stack(
+        [np.cos(theta) + np.cos(3 * theta) / k, np.sin(theta) - np.sin(3 * theta) / k]
+    )
+
+
+@dataclass
+class SyntheticTrial:
+    """One synthetic capture: ``xyz`` (n_frames, 11, 3) mm in `ROLES` order (NaN = not
+    seen), ``truth`` DataFrame (simulator truth-file columns), masks (n_frames, 11) of
+    points displaced by injected jumps and of dropped points."""
+
+    gait: str
+    frequency_hz: float
+    rate_hz: float
+    xyz: np.ndarray
+    truth: pd.DataFrame
+    jumped: np.ndarray
+    dropped: np.ndarray
+
+
+def synthetic_trial(
+    gait: str = "O",
+    frequency_hz: float = 0.5,
+    n_cycles: float = 10.0,
+    rate_hz: float = 100.0,
+    noise_mm: float = 0.2,
+    n_jumps: int = 0,
+    n_dropouts: int = 0,
+    tilt_rad: float = 0.03,
+    seed: int = 0,
+) -> SyntheticTrial:
+    """Build a synthetic trial (see the module docstring); all randomness from ``seed``."""
+    rng = np.random.default_rng(seed)
+    n = int(round(n_cycles * rate_hz / frequency_hz))
+    t = np.arange(n) / rate_hz
+    phase0 = rng.uniform(0, 2 * np.pi)
+    omega = 2 * np.pi * frequency_hz
+    theta = omega * t + phase0
+    phi = gait_shape(gait, theta)
+    flips = np.column_stack([0.6 * (1 + np.sin(theta + 0.8 * i)) for i in range(4)])
+
+    # body motion: prescribed body velocity, heading integrated analytically
+    vx = 8.0 + 4.0 * np.cos(2 * theta)
+    vy = 1.5 * np.sin(theta)
+    w0 = rng.uniform(-0.05, 0.05)
+    heading = rng.uniform(-np.pi, np.pi) + 0.15 * np.sin(theta) + w0 * t
+    wz = 0.15 * omega * np.cos(theta) + w0
+    # world position: integrate on a 20x finer grid for accuracy
+    fine = 20
+    tf = np.arange((n - 1) * fine + 1) / (rate_hz * fine)
+    thf = omega * tf + phase0
+    hf = heading[0] - 0.15 * np.sin(phase0) + 0.15 * np.sin(thf) + w0 * tf
+    vxf, vyf = 8.0 + 4.0 * np.cos(2 * thf), 1.5 * np.sin(thf)
+    dx = np.cos(hf) * vxf - np.sin(hf) * vyf
+    dy = np.sin(hf) * vxf + np.cos(hf) * vyf
+    x = cumulative_trapezoid(dx, tf, initial=0.0)[::fine] + rng.uniform(-200, 200)
+    y = cumulative_trapezoid(dy, tf, initial=0.0)[::fine] + rng.uniform(-200, 200)
+
+    seg_heading = {"head": heading + phi[:, 0], "tail": heading - phi[:, 1]}
+    ch, sh = np.cos(heading), np.sin(heading)
+    joint = {
+        "head": np.column_stack([x + ch * MIDDLE_MM / 2, y + sh * MIDDLE_MM / 2]),
+        "tail": np.column_stack([x - ch * MIDDLE_MM / 2, y - sh * MIDDLE_MM / 2]),
+    }
+
+    def place(segment: str, local_xy: np.ndarray, z: float) -> np.ndarray:
+        a = seg_heading[segment]
+        c, s = np.cos(a), np.sin(a)
+        px = joint[segment][:, 0] + c * local_xy[..., 0] - s * local_xy[..., 1]
+        py = joint[segment][:, 1] + s * local_xy[..., 0] + c * local_xy[..., 1]
+        return np.column_stack([px, py, np.full(n, z)])
+
+    xyz = np.empty((n, len(ROLES), 3))
+    for m, role in enumerate(ROLES):
+        if role in RIGID:
+            segment, (lx, ly, lz) = RIGID[role]
+            xyz[:, m] = place(segment, np.array([lx, ly]), lz)
+        else:
+            segment, hx, side = FLIPPERS[role]
+            a = flips[:, int(role[-1]) - 1]
+            local = np.column_stack(
+                [
+                    hx - FLIPPER_MARKER_MM * np.cos(a),
+                    side * (HALF_WIDTH_MM + FLIPPER_MARKER_MM * np.sin(a)),
+                ]
+            )
+            xyz[:, m] = place(segment, local, FLIPPER_HEIGHT_MM)
+
+    # tilt and offset the whole scene in the capture volume
+    rot = Rotation.from_rotvec(tilt_rad * np.array([0.6, 0.8, 0.0]))
+    xyz = rot.apply(xyz.reshape(-1, 3)).reshape(xyz.shape) + np.array([150.0, -80.0, 30.0])
+    xyz += rng.normal(0.0, noise_mm, xyz.shape)
+
+    jumped = np.zeros((n, len(ROLES)), dtype=bool)
+    for _ in range(n_jumps):
+        m = int(rng.integers(len(ROLES)))
+        start = int(rng.integers(5, n - 10))
+        length = int(rng.integers(1, 4))
+        direction = rng.normal(size=3)
+        direction /= np.linalg.norm(direction)
+        xyz[start : start + length, m] += rng.uniform(12.0, 30.0) * direction
+        jumped[start : start + length, m] = True
+    dropped = np.zeros_like(jumped)
+    for _ in range(n_dropouts):
+        m = int(rng.integers(len(ROLES)))
+        start = int(rng.integers(5, n - 20))
+        dropped[start : start + int(rng.integers(2, 13)), m] = True
+    xyz[dropped] = np.nan
+    jumped &= ~dropped
+
+    truth = pd.DataFrame(
+        {
+            "t": t,
+            "x": x,
+            "y": y,
+            "theta": heading,
+            "vx": vx,
+            "vy": vy,
+            "wz": wz,
+            "phi1": phi[:, 0],
+            "phi2": phi[:, 1],
+            **{f"flipper_{i + 1}": flips[:, i] for i in range(4)},
+            "phase_cmd": theta,
+        }
+    )
+    return SyntheticTrial(gait, frequency_hz, rate_hz, xyz, truth, jumped, dropped)
+
+
+def write_marker_csv(trial: SyntheticTrial, path: Path) -> Path:
+    """Write the trial as a marker CSV (`frame,t,<role>_x,...`, empty = not seen) and its
+    truth as ``<stem>.truth.parquet`` beside it."""
+    path = Path(path)
+    n = len(trial.xyz)
+    cols = {"frame": np.arange(1, n + 1), "t": trial.truth["t"].to_numpy()}
+    for m, role in enumerate(ROLES):
+        for c, axis in enumerate("xyz"):
+            cols[f"{role}_{axis}"] = np.round(trial.xyz[:, m, c], 3)
+    pd.DataFrame(cols).to_csv(path, index=False, float_format="%.3f")
+    trial.truth.to_parquet(path.with_suffix(".truth.parquet"))
+    return path
+
+
+def write_dataset(
+    folder: Path,
+    gaits=("S+", "S-", "O", "D-", "D+"),
+    frequencies=(1 / 3, 1 / 2, 1.0),
+    repeats: int = 1,
+    n_cycles: float = 10.0,
+    seed: int = 0,
+    **kw,
+) -> Path:
+    """Write one synthetic trial per (gait, frequency, repeat) and a manifest; return the
+    manifest's path. Extra keywords go to `synthetic_trial`."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    rows = []
+    i = 0
+    for gait in gaits:
+        for f in frequencies:
+            for r in range(1, repeats + 1):
+                trial = synthetic_trial(gait, f, n_cycles, seed=seed + i, **kw)
+                name = f"trial_{i:03d}.csv"
+                write_marker_csv(trial, folder / name)
+                rows.append(
+                    {
+                        "file": name,
+                        "gait": gait,
+                        "frequency_hz": f"{f:.10g}",
+                        "repeat": r,
+                        "notes": "synthetic",
+                    }
+                )
+                i += 1
+    manifest = folder / "manifest.csv"
+    pd.DataFrame(rows).to_csv(manifest, index=False)
+    return manifest
