@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow lint bench clean
+.PHONY: demo test test-slow browser lint bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -19,8 +19,15 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
-test-slow: $(STAMP)
+# The slow suite screenshots the report with a headless browser; Debian's chromium is
+# installed here (never in `make test`) when apt-get is usable, else that test skips.
+test-slow: $(STAMP) browser
 	$(BIN)/python -m pytest -q -m slow
+
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 \
+	  || (apt-get update -qq && apt-get install -y -qq chromium) \
+	  || echo "no chromium installed: the report screenshot test will skip"
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

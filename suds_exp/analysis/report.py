@@ -19,7 +19,7 @@ from suds_exp.analysis.errors import AnalysisError
 from suds_exp.analysis.glm import REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
-from suds_exp.analysis.spread import iqr_table, slope_table
+from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
 from suds_exp.analysis.tables import to_html, to_markdown, write_table
 from suds_exp.store import Store
 
@@ -36,11 +36,14 @@ def report_tables(
     """Every table of the report, from labelled results (see `load_results`).
 
     Keys: ``categories``, ``glm`` (100 ln scale), ``glm_rmse`` (mm/s), ``iqr``, ``slopes``,
-    and, when the paper's tables are found (``paper_dir`` or the default), ``compare_glm``
+    and, when the paper's tables are found (in ``paper_dir``, which must hold them, or
+    else in the default folder, which may not), ``compare_glm``
     (both scales, column ``scale``), ``compare_iqr`` and ``agreement``. A part that the
     results cannot support (no same-condition pairs, say) is left out. ``pairs``: see
     `iqr_table`.
     """
+    if pairs not in PAIRS:
+        raise AnalysisError(f"--pairs {pairs}: expected one of {', '.join(PAIRS)}")
     tables: dict[str, pd.DataFrame] = {"categories": category_table(results, n_cycles)}
     tables["glm"] = glm_table(results, n_cycles, response="log")
     tables["glm_rmse"] = glm_table(results, n_cycles, response="rmse")
@@ -52,6 +55,8 @@ def report_tables(
     try:
         paper_glm, paper_iqr = paper_table("glm", paper_dir), paper_table("iqr", paper_dir)
     except AnalysisError:
+        if paper_dir is not None:  # asked for by name: say it is not there
+            raise
         return tables
     tables["compare_glm"] = pd.concat(
         [
