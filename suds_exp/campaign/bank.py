@@ -175,10 +175,10 @@ class SampleBank:
     def frame(self, pieces: list[np.ndarray]) -> pd.DataFrame:
         """A samples frame (float columns; trial_id, frame, cycle as int) of row blocks."""
         data = np.concatenate(pieces) if len(pieces) > 1 else np.array(pieces[0])
-        out = pd.DataFrame(data, columns=list(self.columns))
+        columns = {c: data[:, j] for j, c in enumerate(self.columns)}
         for c in ("trial_id", "frame", "cycle"):
-            out[c] = out[c].astype(np.int64)
-        return out
+            columns[c] = columns[c].astype(np.int64)
+        return pd.DataFrame(columns, copy=False)
 
     def describe(self) -> dict[str, list[int]]:
         """Condition -> ids of the trials used, for the campaign definition."""

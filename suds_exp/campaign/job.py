@@ -44,6 +44,7 @@ RESULT_COLUMNS = (
 #: Columns that vary from run to run of the same job (everything else is reproducible).
 TIMING_COLUMNS = ("fit_seconds", "predict_seconds", "finished_at")
 
+VB = ("vx", "vy", "wz")
 Chunk = list[tuple[Draw, list[str]]]
 
 
@@ -72,7 +73,7 @@ def run_draw(
     sample = draw_sample(bank, draw, test_cycles)
     train = bank.frame([bank.rows(*r) for r in sample.train])
     test = bank.frame([bank.rows(*sample.test)])
-    truth = test[["vx", "vy", "wz"]].to_numpy()
+    truth = np.column_stack([test[c].to_numpy() for c in VB])
     ids = bank.trial_ids
     common = {
         "campaign": draw.campaign,
@@ -104,7 +105,7 @@ def run_draw(
             pred = model.predict(test.copy())
             t2 = time.perf_counter()
             fit_s, predict_s = t1 - t0, t2 - t1
-            err = pred[["vx", "vy", "wz"]].to_numpy(dtype=float) - truth
+            err = np.column_stack([pred[c].to_numpy(dtype=float) for c in VB]) - truth
             rmse = tuple(float(v) for v in np.sqrt(np.mean(err**2, axis=0)))
             if not np.all(np.isfinite(rmse)):
                 error = "prediction is not finite (NaN or inf), e.g. a diverging rollout"

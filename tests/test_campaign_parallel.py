@@ -1,0 +1,68 @@
+"""The same campaign gives the same numbers in-process, on 2 loky workers and on dask."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from suds_exp.campaign import CampaignOptions, run_campaign
+from suds_exp.store import Store
+from tests.test_campaign_grid import synthetic_samples
+from tests.test_campaign_runner import results
+
+OPTIONS = dict(models=["phase-only", "TLS+SUDS"], boots=2, train_cycles=3, sweep=[1])
+N_JOBS = (9 * 2 + 3 * 2) * 2
+
+
+@pytest.fixture(scope="module")
+def samples() -> pd.DataFrame:
+    return synthetic_samples(conditions=(("O", 0.5), ("D+", 1.0), ("S-", 1.0)))
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory, samples) -> pd.DataFrame:
+    one = Store(tmp_path_factory.mktemp("one") / "one.duckdb")
+    run_campaign(one, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    frame = results(one)
+    assert len(frame) == N_JOBS
+    return frame
+
+
+def run_on(tmp_path, samples, **kw) -> pd.DataFrame:
+    store = Store(tmp_path / "x.duckdb")
+    summary = run_campaign(
+        store, "c", CampaignOptions(**OPTIONS), samples=samples, chunk_jobs=3, progress=False, **kw
+    )
+    assert summary.done_now == N_JOBS
+    return results(store)
+
+
+def test_two_loky_workers_give_the_rows_of_one(tmp_path, samples, reference):
+    rows = run_on(tmp_path, samples, jobs=2)
+    pd.testing.assert_frame_equal(rows, reference, check_exact=True)
+
+
+def test_dask_backend_gives_the_rows_of_one_worker(tmp_path, samples, reference):
+    distributed = pytest.importorskip("dask.distributed")
+    # in-process cluster (fast); the multi-process cluster is the slow test below
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        rows = run_on(
+            tmp_path, samples, jobs=1, backend="dask", scheduler=cluster.scheduler_address
+        )
+    pd.testing.assert_frame_equal(rows, reference, check_exact=True)
+
+
+@pytest.mark.slow
+def test_a_two_process_dask_local_cluster_gives_the_rows_of_one_worker(
+    tmp_path, samples, reference
+):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        rows = run_on(
+            tmp_path, samples, jobs=2, backend="dask", scheduler=cluster.scheduler_address
+        )
+    pd.testing.assert_frame_equal(rows, reference, check_exact=True)
