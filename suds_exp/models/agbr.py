@@ -37,7 +37,8 @@ per cycle).
 
 Rollout (GMR+SUDS, mode="rollout"): r_p starts at each trial's first measured value and
 is integrated by explicit Euler with the predicted dr_p/dt, clipped to the training range
-widened by half its width; v_b is predicted from the rolled-out r_p.
+widened by a tenth of its width (`rollout_bounds`); v_b is predicted from the rolled-out
+r_p.
 
 Choosing K: `select_k="bic"` fits every K in `k_candidates` and keeps the lowest BIC
 (weighted log-likelihood, augmented samples counted with their weight); off by default
@@ -63,6 +64,7 @@ from suds_exp.models.base import (
     check_int,
     passive_columns,
     require_columns,
+    rollout_bounds,
 )
 from suds_exp.models.mixture import Conditional, fit_mixture, responsibilities
 
@@ -273,6 +275,8 @@ class GMR(Learner):
         T = np.where(rows > 0, counts / np.where(rows > 0, rows, 1.0), self.priors_[None])
         self.transition_ = (1 - self.branch_mix) * T + self.branch_mix * self.priors_[None]
         self.n_features_in_ = d
+        if rp_cols:
+            self.rp_bounds_ = rollout_bounds(as_array(samples, rp_cols, self.name))
         return self
 
     def _inputs(self, samples):
@@ -418,9 +422,8 @@ class GMRSuds(GMR):
         # step is rp_s += dt * drp_s * scale_out / scale_in.
         gain = self.scale_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
         off = self.center_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
-        span = (self.means_[:, 2 : 2 + k].max(0) - self.means_[:, 2 : 2 + k].min(0)) + 1e-9
-        lo = self.means_[:, 2 : 2 + k].min(0) - 0.5 * span - 2.0
-        hi = self.means_[:, 2 : 2 + k].max(0) + 0.5 * span + 2.0
+        lo = (self.rp_bounds_[0] - self.center_[2 : 2 + k]) / self.scale_[2 : 2 + k]
+        hi = (self.rp_bounds_[1] - self.center_[2 : 2 + k]) / self.scale_[2 : 2 + k]
         c = self._cond
         P, mu_in, reg, mu_out = c.prec_in, c.mean_in, c.reg, c.mean_out
         filt = self.branching == "filter"

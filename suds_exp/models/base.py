@@ -125,6 +125,16 @@ def phase_rate(samples: pd.DataFrame) -> np.ndarray:
     return ts.unsort(rate)
 
 
+def rollout_bounds(rp: np.ndarray, margin: float = 0.1) -> np.ndarray:
+    """(2, k) lower and upper limits for rolled-out r_p: the training range widened by
+    `margin` of its width on each side. Passive joints are bounded (flippers open no
+    further than their stops), and a learned drift must not carry r_p where no data was.
+    """
+    lo, hi = rp.min(axis=0), rp.max(axis=0)
+    w = hi - lo
+    return np.stack([lo - margin * w, hi + margin * w])
+
+
 def check_int(name: str, value, low: int, model: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
         raise ConfigError(f"{model}: {name}={value!r}; expected an integer >= {low}")

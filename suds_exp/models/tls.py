@@ -30,8 +30,8 @@ Model (per phase bin k, Bittner et al. 2018 eq. for v_b)::
 
 Rollout (TLS+SUDS, mode="rollout"): at fixed phase and r_a the fitted dr_p/dt is affine
 in r_p, dr_p/dt = a_t + M_t r_p, so r_p is integrated from each trial's first measured
-value by the trapezoidal rule (A-stable, second order): the test trial's r_p is used only
-at its first sample.
+value by the trapezoidal rule (A-stable, second order), clipped to the training range
+widened by a tenth of its width: the test trial's r_p is used only at its first sample.
 """
 
 from __future__ import annotations
@@ -55,6 +55,7 @@ from suds_exp.models.base import (
     passive_columns,
     phase_rate,
     require_columns,
+    rollout_bounds,
 )
 
 _TWO_PI = 2.0 * np.pi
@@ -318,6 +319,8 @@ class TLS(Learner):
             n_kept += kept
         self.bin_coef_ = bin_coef
         self.kept_fraction_ = n_kept / (self.n_bins * q * (p + (self.n_bins > 1)))
+        if rp_cols:
+            self.rp_bounds_ = rollout_bounds(r[:, 2:])
         W = fourier.fit(centres, bin_coef.reshape(self.n_bins, -1), self.coef_order)
         self.coef_ = W.reshape(-1, p + 1, q)
         self.n_features_in_ = p
@@ -437,8 +440,9 @@ class TLSSuds(TLS):
         rp_meas = r[o, 2:]
         out = np.empty((n, k))
         first = ts.first
+        lo, hi = self.rp_bounds_
         x = rp_meas[0]
         for i in range(n):
-            x = rp_meas[i] if first[i] else P[i] @ x + c[i]
+            x = rp_meas[i] if first[i] else np.clip(P[i] @ x + c[i], lo, hi)
             out[i] = x
         return ts.unsort(out)
