@@ -167,3 +167,48 @@ def test_cli_run_and_status(db, samples, monkeypatch):
     assert out.exit_code == 2 and "boots: 1 -> 2" in out.output
     out = runner.invoke(cli.app, ["status", "nope", "--db", str(db)])
     assert out.exit_code == 2 and "no campaign 'nope'" in out.output
+
+
+def test_cli_runs_all_five_learners_on_preprocessed_captures(tmp_path):
+    from suds_exp.preprocess import preprocess
+    from suds_exp.preprocess.synthetic import write_dataset
+
+    manifest = write_dataset(
+        tmp_path / "data", gaits=("O", "D+"), frequencies=(0.5, 1.0), repeats=2, n_cycles=6
+    )
+    db = tmp_path / "e2e.duckdb"
+    runner = CliRunner()
+    out = runner.invoke(
+        cli.app,
+        ["ingest", str(tmp_path / "data"), "--manifest", str(manifest), "--db", str(db), "--quiet"],
+    )
+    assert out.exit_code == 0, out.output
+    preprocess(Store(db), progress=False)
+    args = [
+        "run",
+        "e2e",
+        "--db",
+        str(db),
+        "--boots",
+        "1",
+        "--train-cycles",
+        "3",
+        "--test-conditions",
+        "O@1",
+        "--sweep",
+        "1",
+        "--json",
+    ]
+    out = runner.invoke(cli.app, args)
+    assert out.exit_code == 0, out.output
+    doc = json.loads(out.stdout)
+    # 4 train x 1 test conditions + the O@1 same-condition sweep point, x 5 learners
+    assert doc["done_now"] == doc["total_jobs"] == (4 + 1) * 5 and doc["failed_now"] == 0
+    frame = Store(db).query_df("SELECT * FROM results")
+    assert set(frame.model) == {"phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS"}
+    assert frame.rmse_vx.notna().all() and set(frame.test_frequency_hz) == {1.0}
+    # the preprocessing version was the only one, so it was chosen and recorded
+    (prep,) = Store(db).query_df("SELECT prep_version FROM campaigns").prep_version
+    assert prep == "v1"
+    out = runner.invoke(cli.app, ["run", "e2e", "--db", str(db), "--mode", "rollout"])
+    assert out.exit_code == 2 and "mode" in out.output
