@@ -1,5 +1,7 @@
 """The learners' public face: make_model, the estimator contract, frames in and out."""
 
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -51,6 +53,11 @@ def test_fit_predict_contract(data, name, params):
     again = type(m)(**m.get_params()).fit(train).predict(test)
     np.testing.assert_array_equal(pred.to_numpy(), again.to_numpy())
     np.testing.assert_array_equal(pred.to_numpy(), clone(m).fit(train).predict(test).to_numpy())
+    # the campaign stores the recipe as JSON (tuples come back as lists)
+    stored = json.loads(json.dumps(m.get_params(), default=list))
+    np.testing.assert_array_equal(
+        pred.to_numpy(), make_model(name, **stored).fit(train).predict(test)
+    )
 
 
 @pytest.mark.parametrize(("name", "params"), VARIANTS, ids=IDS)
