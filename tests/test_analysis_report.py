@@ -186,3 +186,39 @@ def test_headless_browser_screenshot_shows_the_figures(report, tmp_path):
     assert _pixels_near(shot, orange) > 500
     assert _pixels_near(shot, purple) > 500
     assert _pixels_near(control, orange) == 0 and _pixels_near(control, purple) == 0
+
+
+def test_a_sparse_campaign_still_reports_and_says_what_it_could_not_estimate(tmp_path):
+    # Two learners whose SUDS and GMR flags always agree, two gaits two steps apart (no
+    # 'near' pair, the paper's reference), two frequencies, a small same-condition sweep.
+    rows = synthetic_results("small", n_boot=2, models=("TLS", "GMR+SUDS"), n_cycles=(2, 4, 8))
+    keep = (
+        rows["train_gait"].isin(["O", "D+"])
+        & rows["test_gait"].isin(["O", "D+"])
+        & rows["train_frequency_hz"].isin([0.5, 1.0])
+        & rows["test_frequency_hz"].isin([0.5, 1.0])
+    )
+    rows = rows[keep]
+    same = (rows["train_gait"] == rows["test_gait"]) & (
+        rows["train_frequency_hz"] == rows["test_frequency_hz"]
+    )
+    rows = rows[(rows["n_cycles"] == 8) | same]
+    store = Store(tmp_path / "s.duckdb")
+    with store.write() as conn:
+        store.insert_df(conn, "results", rows)
+    result = cli("report", "small", "--db", store.path, "--out", tmp_path / "rep")
+    assert result.exit_code == 0, result.output
+    glm = pd.read_csv(tmp_path / "rep" / "glm.csv")
+    blank = glm[glm["coef"].isna()]
+    assert set(blank["term"]) == {
+        "GMR",
+        "SUDS:GMR",
+        "GMR:(model-period<data-period)",
+        "GMR:(model-period=data-period)",
+        "GMR:(model-gait=data-gait)",
+    }
+    assert glm.loc[glm["coef"].notna(), "ci_low"].notna().all()
+    page = (tmp_path / "rep" / "index.html").read_text()
+    assert "Not the paper's references" in page and "Not estimable" in page
+    for ref in re.findall(r'(?:src|href)="([^"]*)"', page):
+        assert (tmp_path / "rep" / ref).is_file(), ref

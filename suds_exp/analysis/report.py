@@ -16,7 +16,7 @@ import pandas as pd
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
 from suds_exp.analysis.errors import AnalysisError
-from suds_exp.analysis.glm import REFERENCE, glm_table
+from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
@@ -180,6 +180,28 @@ def write_report(
     return index
 
 
+def _reference_note(refs: dict[str, str]) -> str:
+    """Says whether the reference levels are the paper's, and why not when they are not."""
+    paper = {k: LEVEL_NAMES[(k, v)] for k, v in REFERENCE.items()}
+    if refs == paper:
+        return "These are the paper's reference levels."
+    notes = []
+    for key, name in paper.items():
+        if key not in refs:
+            notes.append(f"{key} has one level in these results and is left out")
+        elif refs[key] != name:
+            notes.append(f"{name} is absent from these results, so {refs[key]} is the reference")
+    return (
+        "<b>Not the paper's references:</b> "
+        + _esc_join(notes)
+        + "; terms of that factor are not comparable with the paper's."
+    )
+
+
+def _esc_join(items: list[str]) -> str:
+    return "; ".join(html.escape(i) for i in items)
+
+
 def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
     esc = html.escape
     glm = tables["glm"]
@@ -212,21 +234,17 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         f"{glm.attrs['n_rows']} learner results at {size} cycles, phase-only left out "
         "(it has neither SUDS nor GMR and would count as TLS). 95 % confidence intervals; "
         "terms sorted by magnitude after the intercept.</p>",
-        "<p>Reference levels, as the paper: TLS (SUDS = GMR = 0), "
-        + ", ".join(esc(v) for v in refs.values())
-        + "."
-        + (
-            ""
-            if all(glm.attrs["reference"].get(k) for k in REFERENCE)
-            else " (A factor with one level in these results is left out of the model.)"
-        )
+        f"<p>Reference levels: TLS (SUDS = GMR = 0), {esc(', '.join(refs.values()))}. "
+        + _reference_note(refs)
         + "</p>",
     ]
-    if glm.attrs["rank_deficient"]:
+    aliased = sorted({t for terms in glm.attrs["aliased"].values() for t in terms})
+    if aliased:
         parts.append(
-            '<p class="note"><b>Warning:</b> some category combinations are missing from these '
-            "results, so not every interaction is identifiable; read those coefficients with "
-            "care.</p>"
+            '<p class="note"><b>Not estimable from these results</b> (a category combination '
+            "is missing, or two predictors are always equal), left blank: "
+            + ", ".join(esc(t) for t in aliased)
+            + ".</p>"
         )
     for label in ("direct", "interactions"):
         parts += [
