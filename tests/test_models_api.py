@@ -111,3 +111,15 @@ def test_bad_frames_are_refused(data):
         make_model("TLS").fit(train.assign(vx=np.where(train.index == 5, np.nan, train["vx"])))
     with pytest.raises(ModelError, match="before fit"):
         make_model("GMR").predict(train)
+
+
+def test_a_gap_inside_a_trial_restarts_the_series(data):
+    """Two cycle windows cut from one trial behave like two trials (rollout restarts)."""
+    _, test = data
+    one = test[test["trial_id"] == test["trial_id"].iloc[0]]
+    cut = one[(one["cycle"] - one["cycle"].min()).isin([0, 2])]
+    as_two = cut.assign(trial_id=np.where(cut["cycle"] == cut["cycle"].min(), 1, 2))
+    train = data[0]
+    for name in ("TLS+SUDS", "GMR+SUDS"):
+        m = make_model(name, mode="rollout").fit(train)
+        np.testing.assert_allclose(m.predict(cut), m.predict(as_two), rtol=1e-9, atol=1e-9)

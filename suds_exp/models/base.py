@@ -22,6 +22,7 @@ VB_COLUMNS = ("vx", "vy", "wz")
 RA_COLUMNS = ("ra_1", "ra_2")
 DRA_COLUMNS = ("dra_1", "dra_2")
 _RP_PATTERN = re.compile(r"^rp_(\d+)$")
+GAP_FACTOR = 5.0
 
 
 class ModelError(SudsError):
@@ -66,7 +67,7 @@ def as_array(samples: pd.DataFrame, columns, model: str) -> np.ndarray:
 
 @dataclass(frozen=True)
 class TimeSeries:
-    """Row order that makes every trial a contiguous, time-ordered run.
+    """Row order that makes every trial (or gap-free stretch of one) a time-ordered run.
 
     `order` (n,) indexes the caller's rows in (trial_id, t) order; `starts` (n_trials + 1,)
     are the run boundaries in that order; `dt` (n,) is the step to the previous sample of
@@ -85,8 +86,15 @@ class TimeSeries:
         ts, tr = t[order], trial[order]
         new = np.ones(len(order), dtype=bool)
         new[1:] = tr[1:] != tr[:-1]
-        starts = np.append(np.flatnonzero(new), len(order))
         dt = np.diff(ts, prepend=ts[0])
+        # Two cycle windows cut from one trial are two series too: a step more than
+        # GAP_FACTOR times the median step starts a new run.
+        steps = dt[~new]
+        if steps.size:
+            typical = np.median(steps[steps > 0]) if (steps > 0).any() else 0.0
+            if typical > 0:
+                new |= dt > GAP_FACTOR * typical
+        starts = np.append(np.flatnonzero(new), len(order))
         dt[new] = 0.0
         return cls(order=order, starts=starts, dt=dt)
 
