@@ -56,17 +56,22 @@ def ingest_file(
     condition: Condition | None = None,
     layout: dict[str, str] | None = None,
     layout_source: str = "layout",
+    conn: sa.Connection | None = None,
 ) -> IngestResult:
     """Read, validate and store one capture file in one transaction.
 
     A file whose content hash is already stored is skipped. Raises `IngestError` (and
     writes nothing) for a bad file, a layout naming markers the file lacks, or a
-    condition already taken by a different capture.
+    condition already taken by a different capture. ``conn``: a connection from
+    ``store.writer()`` to reuse (the transaction is still this file's own).
     """
     capture, digest = read_capture(path)
     if layout is not None:
         check_layout(layout, capture.marker_names, layout_source, path)
-    with store.write() as conn:
+    if conn is None:
+        with store.writer() as own:
+            return ingest_file(store, path, condition, layout, layout_source, own)
+    with conn.begin():
         existing = conn.execute(
             sa.select(trials.c.id).where(trials.c.content_hash == digest)
         ).scalar_one_or_none()
@@ -155,18 +160,11 @@ def ingest_paths(
     if not files:
         raise IngestError("nothing to ingest: give capture files, folders or --manifest")
     results = []
-    with progress_bar(
-        "Ingesting", total=len(files), enabled=progress and len(files) > 1
-    ) as advance:
+    source = str(layout) if layout else "layout"
+    bar = progress_bar("Ingesting", total=len(files), enabled=progress and len(files) > 1)
+    with bar as advance, store.writer() as conn:
         for path in files:
-            results.append(
-                ingest_file(
-                    store,
-                    path,
-                    conditions.get(Path(path).resolve()),
-                    roles,
-                    str(layout) if layout else "layout",
-                )
-            )
+            condition = conditions.get(Path(path).resolve())
+            results.append(ingest_file(store, path, condition, roles, source, conn))
             advance()
     return results

@@ -53,17 +53,28 @@ class Store:
         return applied
 
     @contextmanager
-    def write(self) -> Iterator[sa.Connection]:
-        """A connection in one transaction; the file is held only inside the block."""
+    def writer(self) -> Iterator[sa.Connection]:
+        """A writable connection without a transaction; ``with conn.begin():`` per unit.
+
+        For many small transactions in a row (one per ingested file): the file is held
+        for the whole block, and DuckDB checkpoints once when it ends instead of after
+        every transaction.
+        """
         if not self._migrated:
             self.upgrade()
         engine = make_engine(self.path)
         try:
             conn = retry_on_lock(engine.connect, self.path)
-            with conn, conn.begin():
+            with conn:
                 yield conn
         finally:
             engine.dispose()
+
+    @contextmanager
+    def write(self) -> Iterator[sa.Connection]:
+        """A connection in one transaction; the file is held only inside the block."""
+        with self.writer() as conn, conn.begin():
+            yield conn
 
     @contextmanager
     def read(self) -> Iterator[sa.Connection]:
