@@ -55,9 +55,8 @@ def main() -> None:
     o, b = statistics.median(ours), statistics.median(baseline)
     rows = args.files * args.frames * len(ROLES)
     print(f"{args.files} files x {args.frames} frames x {len(ROLES)} markers ({size:.0f} MB)")
-    print(
-        f"ingest_paths (parse, validate, store): median {o:.2f} s  ({rows / o / 1e6:.2f} M marker rows/s)"
-    )
+    rate = rows / o / 1e6
+    print(f"ingest_paths (parse, validate, store): median {o:.2f} s ({rate:.2f} M rows/s)")
     print(f"pandas.read_csv parse only (baseline): median {b:.2f} s")
     print(f"ratio ingest / bare parse: {o / b:.2f}x")
 
