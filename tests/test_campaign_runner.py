@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import shutil
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -11,10 +13,13 @@ from typer.testing import CliRunner
 import cli
 from suds_exp.campaign import (
     KEY_COLUMNS,
+    LEARNERS,
     TIMING_COLUMNS,
     CampaignError,
     CampaignOptions,
     campaign_status,
+    demo_campaign,
+    demo_options,
     run_campaign,
 )
 from suds_exp.campaign.lock import RunLock
@@ -169,21 +174,30 @@ def test_cli_run_and_status(db, samples, monkeypatch):
     assert out.exit_code == 2 and "no campaign 'nope'" in out.output
 
 
-def test_cli_runs_all_five_learners_on_preprocessed_captures(tmp_path):
+@pytest.fixture(scope="module")
+def captured(tmp_path_factory) -> Path:
+    """A database with preprocessed synthetic captures: 2 gaits x 2 frequencies x 2."""
     from suds_exp.preprocess import preprocess
     from suds_exp.preprocess.synthetic import write_dataset
 
+    folder = tmp_path_factory.mktemp("captured")
     manifest = write_dataset(
-        tmp_path / "data", gaits=("O", "D+"), frequencies=(0.5, 1.0), repeats=2, n_cycles=6
+        folder / "data", gaits=("O", "D+"), frequencies=(0.5, 1.0), repeats=2, n_cycles=6
     )
-    db = tmp_path / "e2e.duckdb"
-    runner = CliRunner()
-    out = runner.invoke(
+    db = folder / "e2e.duckdb"
+    out = CliRunner().invoke(
         cli.app,
-        ["ingest", str(tmp_path / "data"), "--manifest", str(manifest), "--db", str(db), "--quiet"],
+        ["ingest", str(folder / "data"), "--manifest", str(manifest), "--db", str(db), "--quiet"],
     )
     assert out.exit_code == 0, out.output
     preprocess(Store(db), progress=False)
+    return db
+
+
+def test_cli_runs_all_five_learners_on_preprocessed_captures(tmp_path, captured):
+    db = tmp_path / "e2e.duckdb"
+    shutil.copy(captured, db)
+    runner = CliRunner()
     args = [
         "run",
         "e2e",
@@ -212,3 +226,28 @@ def test_cli_runs_all_five_learners_on_preprocessed_captures(tmp_path):
     assert prep == "v1"
     out = runner.invoke(cli.app, ["run", "e2e", "--db", str(db), "--mode", "rollout"])
     assert out.exit_code == 2 and "mode" in out.output
+
+
+def test_demo_options_pick_a_few_conditions_at_the_extreme_frequencies():
+    samples = synthetic_samples(
+        conditions=(("O", 1 / 3), ("O", 0.5), ("O", 1.0), ("D+", 1 / 3), ("D+", 1.0), ("S-", 1.0))
+    )
+    options = demo_options(samples, prep="v1")
+    assert options.train_conditions == options.test_conditions == "O@0.333333,O@1,D+@0.333333,D+@1"
+    assert list(options.models) == list(LEARNERS) and options.boots == 2
+    assert options.train_cycles == 5 and options.sweep == [1, 2]
+    short = synthetic_samples(conditions=(("O", 1.0),), trials_per_condition=2, cycles=(4.5, 5))
+    assert demo_options(short).train_cycles < 5
+
+
+@pytest.mark.slow
+def test_the_demo_campaign_runs_all_five_learners_on_a_few_conditions(tmp_path, captured):
+    db = tmp_path / "demo.duckdb"
+    shutil.copy(captured, db)
+    summary = demo_campaign(Store(db), jobs=1, progress=False)
+    assert summary.done_now == summary.total_jobs > 0 and summary.failed_now == 0
+    frame = Store(db).query_df("SELECT * FROM results WHERE campaign = 'demo'")
+    assert set(frame.model) == set(LEARNERS)
+    assert frame.train_gait.nunique() == 2 and frame.train_frequency_hz.nunique() == 2
+    again = demo_campaign(Store(db), jobs=1, progress=False)
+    assert again.done_now == 0 and again.remaining == 0

@@ -8,6 +8,7 @@ runs the small campaign of `suds-exp demo`.
 from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import PAPER_SWEEP, parse_int_list
 from suds_exp.campaign.definition import LEARNERS, CampaignOptions
+from suds_exp.campaign.demo import demo_campaign, demo_options
 from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import KEY_COLUMNS, Draw, enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, TIMING_COLUMNS
@@ -26,6 +27,8 @@ __all__ = [
     "RunSummary",
     "SampleBank",
     "campaign_status",
+    "demo_campaign",
+    "demo_options",
     "enumerate_draws",
     "parse_int_list",
     "run_campaign",

@@ -203,7 +203,7 @@ def run_campaign(
         dask scheduler address (``tcp://host:8786``); None with dask starts a local
         cluster of ``jobs`` single-threaded workers.
     chunk_jobs : int, optional
-        Jobs per task sent to a worker (default: enough for ~30 tasks per worker, 1-64).
+        Jobs per task sent to a worker (default: enough for ~30 tasks per worker, 1-32).
     batch_rows, flush_seconds : int, float
         Write finished rows when this many are waiting or this long after the last write.
     progress : bool
@@ -247,7 +247,7 @@ def run_campaign(
                     + "); continue it with its stored options or choose a new NAME"
                 )
         check_feasible(bank, plan.train_conditions, plan.test_conditions, _max_cycles(plan))
-        done = finished_keys(store, name) if stored is not None else set()
+        done = finished_keys(store, name)
         n_workers = _n_workers(jobs, backend, scheduler)
         chunks, total, pending = pending_chunks(
             plan, done, chunk_jobs or _default_chunk(len(done), plan, n_workers)
@@ -301,7 +301,7 @@ def _default_chunk(_done: int, plan: Plan, n_workers: int) -> int:
     if n_workers <= 1:
         return len(plan.models)
     total = len(plan.train_conditions) * len(plan.test_conditions) * plan.boots * len(plan.models)
-    return int(min(64, max(1, math.ceil(total / (n_workers * 30)))))
+    return int(min(32, max(1, math.ceil(total / (n_workers * 30)))))
 
 
 def _record_start(store, plan, create, total, backend, n_workers, pending) -> None:
