@@ -139,7 +139,7 @@ class GMR(Learner):
 
     Parameters
     ----------
-    n_components : int, default 12
+    n_components : int, default 16
         Number of Gaussian components K.
     reg_covar : float, default 1e-3
         Added to each covariance diagonal (standardised units).
@@ -183,7 +183,7 @@ class GMR(Learner):
 
     def __init__(
         self,
-        n_components: int = 12,
+        n_components: int = 16,
         reg_covar: float = 1e-3,
         max_iter: int = 60,
         tol: float = 1e-3,
@@ -377,7 +377,7 @@ class GMRSuds(GMR):
 
     def __init__(
         self,
-        n_components: int = 12,
+        n_components: int = 16,
         reg_covar: float = 1e-3,
         max_iter: int = 60,
         tol: float = 1e-3,
