@@ -97,11 +97,12 @@ class Hinges:
 
 @dataclass
 class Actuator:
-    """Motor tracking: first-order lag plus smooth (Ornstein-Uhlenbeck) angle noise."""
+    """Motor tracking: smooth random tracking error (sd noise_rad, correlation time
+    noise_corr_s; second-order filtered noise) on the command, then a first-order lag."""
 
     lag_s: float = 0.04
     noise_rad: float = 0.02
-    noise_corr_s: float = 0.2
+    noise_corr_s: float = 0.3
 
 
 @dataclass

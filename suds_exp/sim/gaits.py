@@ -40,21 +40,25 @@ def gait_shape(gait: str, theta: np.ndarray) -> np.ndarray:
 
 
 def actuate(phi_cmd: np.ndarray, dt: float, actuator: Actuator, rng: np.random.Generator):
-    """Realised joint angles from commanded ones: first-order lag plus OU noise.
+    """Realised joint angles from commanded ones: OU tracking noise, then first-order lag.
 
     phi_cmd: array (n, 2), rad, every dt s. Returns array (n, 2), rad; starts at the
     command (the robot is placed in its initial shape before the trial).
     """
     phi_cmd = np.asarray(phi_cmd, dtype=float)
-    out = phi_cmd.copy()
+    target = phi_cmd.copy()
+    if actuator.noise_rad > 0:
+        # tracking error: white noise through two first-order filters of time constant
+        # noise_corr_s (a smooth process, stationary sd noise_rad), on the target
+        b = np.exp(-dt / max(actuator.noise_corr_s, dt))
+        drive = rng.normal(size=phi_cmd.shape) * np.sqrt(1 - b * b)
+        x0 = rng.normal(size=2)
+        x = lfilter([1.0], [1.0, -b], drive, axis=0, zi=(b * x0)[None, :])[0]
+        y = lfilter([1 - b], [1.0, -b], x, axis=0, zi=(b * x0)[None, :])[0]
+        target = target + y * actuator.noise_rad * (1 + b) / np.sqrt(1 + b * b)
+    out = target
     if actuator.lag_s > 0:
         a = np.exp(-dt / actuator.lag_s)
-        zi = (a * phi_cmd[0])[None, :]
-        out = lfilter([1 - a], [1, -a], phi_cmd, axis=0, zi=zi)[0]
-    if actuator.noise_rad > 0:
-        # Ornstein-Uhlenbeck noise with stationary sd noise_rad, correlation noise_corr_s
-        b = np.exp(-dt / max(actuator.noise_corr_s, dt))
-        drive = rng.normal(size=phi_cmd.shape) * actuator.noise_rad * np.sqrt(1 - b * b)
-        zi = (rng.normal(size=2) * actuator.noise_rad * b)[None, :]
-        out = out + lfilter([1.0], [1.0, -b], drive, axis=0, zi=zi)[0]
+        zi = (a * target[0])[None, :]
+        out = lfilter([1 - a], [1, -a], target, axis=0, zi=zi)[0]
     return out

@@ -248,5 +248,5 @@ def simulate_prescribed(
         "continuations": n_cont,
     }
     if single:
-        out = {k: (v[0] if v.ndim > 1 else v) for k, v in out.items()}
+        out = {k: v[0] for k, v in out.items()}
     return out
