@@ -337,5 +337,28 @@ def report(
         console.out.print(f"wrote {index}")
 
 
+@command()
+def demo(
+    db: DbOption = None,
+    out: Annotated[Path, typer.Option(help="Folder for the campaign report.")] = Path("reports"),
+    jobs: Annotated[int, typer.Option(help="Worker processes for the campaign.")] = 2,
+    quiet: QuietOption = False,
+    json_: JsonOption = False,
+) -> None:
+    """Run the whole pipeline on the built-in simulated robot (a few minutes).
+
+    Simulates the paper's design into a temporary folder, ingests it, preprocesses it,
+    runs a small campaign with all five learners and writes its report.
+    """
+    from suds_exp.demo import run_demo
+
+    say = (lambda line: None) if json_ else console.out.print
+    summary = run_demo(open_store(db), out, jobs=jobs, progress=not (quiet or json_), say=say)
+    if json_:
+        console.print_json(summary.__dict__)
+    else:
+        console.out.print(f"open {summary.report} in a browser to see the results")
+
+
 if __name__ == "__main__":
     app()

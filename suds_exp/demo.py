@@ -74,9 +74,8 @@ def run_demo(
         results = ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=progress)
         summary.n_trials = len(results)
         fresh = sum(r.status == "ingested" for r in results)
-        say(
-            f"ingested {fresh} new trials ({len(results) - fresh} already stored) in {lap('ingest'):.0f} s"
-        )
+        stored = len(results) - fresh
+        say(f"ingested {fresh} new trials ({stored} already stored) in {lap('ingest'):.0f} s")
 
     prep = preprocess(store, progress=progress)
     summary.prep_version = prep.name
@@ -84,13 +83,15 @@ def run_demo(
     say(
         f"preprocessing version {prep.name}: {len(prep.processed)} trials processed, "
         f"{len(prep.skipped)} already done; passive PCs explain "
-        f"{100 * sum(prep.explained_variance_ratio):.0f}% of the variance ({lap('preprocess'):.0f} s)"
+        f"{100 * sum(prep.explained_variance_ratio):.0f}% of the variance "
+        f"({lap('preprocess'):.0f} s)"
     )
 
     run = demo_campaign(store, campaign, prep=prep.name, jobs=jobs, progress=progress)
     summary.n_results = run.done_before + run.done_now
     say(
-        f"campaign {campaign!r}: {summary.n_results} of {run.total_jobs} jobs done ({lap('campaign'):.0f} s)"
+        f"campaign {campaign!r}: {summary.n_results} of {run.total_jobs} jobs done "
+        f"({lap('campaign'):.0f} s)"
     )
 
     summary.report = write_report(store, campaign, report_dir / campaign)
