@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogFormatter
 
 from suds_exp.analysis.categories import FREQ_SIM, GAIT_SIM, at_cycles, learner_order
 
@@ -103,9 +104,16 @@ def efficiency_figure(iqr: pd.DataFrame, slopes: pd.DataFrame, path: Path) -> Pa
             ax.fill_between(g["n_cycles"], g["q1"], g["q3"], color=color, alpha=0.15, linewidth=0)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):  # plain numbers (2, 5, 20), not 2 x 10^0
+            axis.set_major_formatter(LogFormatter())
+            axis.set_minor_formatter(LogFormatter(labelOnlyBase=False, minor_thresholds=(2, 0.4)))
         ax.set_xlabel("training cycles")
         ax.set_title(f"{frequency_name(freq)} Hz")
-        ax.legend(fontsize="small")
+        fitted = slopes[slopes["frequency_hz"] == freq]
+        title = None
+        if not fitted.empty:
+            title = f"slope over {fitted['cycles_from'].min()}-{fitted['cycles_to'].max()} cycles"
+        ax.legend(fontsize="small", title=title, title_fontsize="small")
     axes[0].set_ylabel("RMS error of vx (mm/s), median and IQR")
     fig.suptitle("RMS error against training cycles (log-log)")
     return _save(fig, path)

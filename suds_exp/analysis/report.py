@@ -261,7 +261,7 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         "let that reading be checked. Their size depends on the unit.</p>",
     ]
     for label in ("direct", "interactions"):
-        parts.append(to_html(raw[raw["model"] == label], 2))
+        parts.append(to_html(raw[raw["model"] == label].drop(columns="model"), 2))
     parts.append(f"<p>Files: {_files(files['glm_rmse'])}</p>")
 
     parts.append("<h2>3. Spread: IQR of RMS error of vx</h2>")
