@@ -7,13 +7,15 @@ tested) on a gait one step from the training gait (``near``). Each coefficient i
 change from that reference.
 
 The response is ``100 ln(rmse_vx)`` by default. The paper calls its response "log RMS
-error" but its intercepts (68.72, 91.36) and effects (tens) cannot be natural or decimal
-logs of RMS errors whose spreads it reports as 3-57 units; on 100 x ln, a coefficient reads
-as an approximate percentage change of the RMS error (-10 ~ 10 % lower), and it does not
-depend on the unit of the RMS error, so signs, orderings and effect sizes can be set beside
-the paper's. The paper's own reading of its coefficients (e.g. SUDS -47.53 with intercept
-91.36 called a "52 % error reduction") treats them as linear in RMS error, so the raw scale
-(``response="rmse"``, mm/s) is available as well; its coefficients depend on the unit.
+error", but an intercept of 68.72 (91.36 with interactions) cannot be a plain natural or
+decimal log of an RMS error whose inter-quartile ranges it gives as 3-57 units (that would
+be an error of e^68); its magnitudes fit a log scaled by 100, or a response linear in the
+error. On ``100 ln``, a coefficient reads as roughly a percentage change of the RMS error
+(-10 ~ 10 % lower) and does not depend on the error's unit, so signs, orderings and effect
+sizes can be set beside the paper's. The paper's own reading of its coefficients (SUDS
+-47.53 against intercept 91.36 called a "52 % error reduction") treats them as linear in
+RMS error, so that scale (``response="rmse"``, mm/s) is fitted too; its coefficients depend
+on the unit. The model is a Gaussian GLM with identity link, i.e. ordinary least squares.
 Phase-only rows are left out: with neither SUDS nor GMR they would be counted as TLS.
 """
 

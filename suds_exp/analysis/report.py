@@ -49,9 +49,10 @@ def report_tables(
     tables["glm_rmse"] = glm_table(results, n_cycles, response="rmse")
     try:
         tables["iqr"] = iqr_table(results, pairs)
-        tables["slopes"] = slope_table(results, upper_from, pairs)
-    except AnalysisError:
+    except AnalysisError:  # no such pairs: the report says so instead
         pass
+    else:
+        tables["slopes"] = slope_table(results, upper_from, pairs)
     try:
         paper_glm, paper_iqr = paper_table("glm", paper_dir), paper_table("iqr", paper_dir)
     except AnalysisError:
