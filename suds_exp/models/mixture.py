@@ -59,30 +59,34 @@ def _logsumexp(a: np.ndarray) -> np.ndarray:
     return (m + np.log(np.exp(a - m).sum(axis=1, keepdims=True)))[:, 0]
 
 
+def _draw(weights: np.ndarray, rng) -> int:
+    """One index drawn with probability proportional to `weights` (n,), non-negative."""
+    c = np.cumsum(weights)
+    return int(min(np.searchsorted(c, rng.uniform() * c[-1], side="right"), len(c) - 1))
+
+
 def kmeans_pp(X, w, K, rng, n_lloyd: int = 5) -> np.ndarray:
     """Hard labels (n_samples,) from weighted k-means++ seeding and a few Lloyd steps."""
     n = len(X)
-    p = w / w.sum()
+    x2 = np.einsum("nd,nd->n", X, X)
     centres = np.empty((K, X.shape[1]))
-    centres[0] = X[rng.choice(n, p=p)]
-    d2 = ((X - centres[0]) ** 2).sum(1)
+    centres[0] = X[_draw(w, rng)]
+    d2 = np.maximum(x2 - 2.0 * (X @ centres[0]) + centres[0] @ centres[0], 0.0)
     for k in range(1, K):
         q = w * d2
-        s = q.sum()
-        idx = rng.choice(n, p=q / s) if s > 0 else rng.choice(n, p=p)
-        centres[k] = X[idx]
-        d2 = np.minimum(d2, ((X - centres[k]) ** 2).sum(1))
-    x2 = (X * X).sum(1)
+        centres[k] = X[_draw(q if q.sum() > 0 else w, rng)]
+        dk = x2 - 2.0 * (X @ centres[k]) + centres[k] @ centres[k]
+        np.minimum(d2, np.maximum(dk, 0.0), out=d2)
+    Xw = X * w[:, None]
+    rows = np.arange(n)
     for _ in range(n_lloyd):
-        dist = x2[:, None] - 2 * X @ centres.T + (centres * centres).sum(1)[None]
-        labels = dist.argmin(1)
-        wk = np.bincount(labels, weights=w, minlength=K)
-        sums = np.zeros_like(centres)
-        np.add.at(sums, labels, X * w[:, None])
+        labels = ((centres * centres).sum(1)[None] - 2.0 * (X @ centres.T)).argmin(1)
+        onehot = np.zeros((n, K))
+        onehot[rows, labels] = 1.0
+        wk = onehot.T @ w
         ok = wk > 0
-        centres[ok] = sums[ok] / wk[ok, None]
-    dist = x2[:, None] - 2 * X @ centres.T + (centres * centres).sum(1)[None]
-    return dist.argmin(1)
+        centres[ok] = (onehot.T @ Xw)[ok] / wk[ok, None]
+    return ((centres * centres).sum(1)[None] - 2.0 * (X @ centres.T)).argmin(1)
 
 
 class _Moments:
