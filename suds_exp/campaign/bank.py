@@ -100,38 +100,43 @@ class SampleBank:
             frame, hz = frame.loc[keep], hz.loc[keep]
         if frame.empty:
             raise CampaignError("no samples with a (gait, frequency) condition to run on")
-        frame = frame.assign(_hz=hz.to_numpy()).sort_values(["trial_id", "t"], kind="stable")
-        groups = [(tid, g) for tid, g in frame.groupby("trial_id", sort=True)]
+        order = np.lexsort((frame["t"].to_numpy(float), frame["trial_id"].to_numpy()))
+        values = frame[columns].to_numpy(dtype=np.float64)[order]
+        gait = frame["gait"].astype(str).to_numpy()[order]
+        hz = hz.to_numpy()[order]
+        trial = values[:, 0].astype(np.int64)
+        edges = np.flatnonzero(np.diff(trial)) + 1
+        lo = np.concatenate([[0], edges])
+        hi = np.concatenate([edges, [len(trial)]])
+        t_col, ph_col, cy_col = (columns.index(c) for c in ("t", "phase", "cycle"))
 
         raw_spc = []
-        for tid, g in groups:
-            conds = g[["gait", "_hz"]].drop_duplicates()
-            if len(conds) != 1:
-                raise CampaignError(f"samples of trial {tid} have more than one condition")
-            dt = np.median(np.diff(g["t"].to_numpy(dtype=float))) if len(g) > 1 else np.nan
+        for a, b in zip(lo, hi, strict=True):
+            if (gait[a:b] != gait[a]).any() or (hz[a:b] != hz[a]).any():
+                raise CampaignError(f"samples of trial {trial[a]} have more than one condition")
+            dt = np.median(np.diff(values[a:b, t_col])) if b - a > 1 else np.nan
             if not np.isfinite(dt) or dt <= 0:
-                raise CampaignError(f"trial {tid}: cannot tell its sample rate from column t")
-            raw_spc.append(1.0 / (dt * float(conds["_hz"].iloc[0])))
+                raise CampaignError(f"trial {trial[a]}: cannot tell its sample rate from column t")
+            raw_spc.append(1.0 / (dt * hz[a]))
         target = int(round(min(raw_spc)))
 
-        blocks, starts, stops, tids, conds_out, runs_out = [], [], [], [], [], []
+        keep = np.zeros(len(trial), dtype=bool)
+        starts, stops, conds_out, runs_out = [], [], [], []
         decimation: dict[float, int] = {}
         row = 0
-        for (tid, g), spc in zip(groups, raw_spc, strict=True):
-            cond = (str(g["gait"].iloc[0]), float(g["_hz"].iloc[0]))
+        for a, b, spc in zip(lo, hi, raw_spc, strict=True):
+            cond = (str(gait[a]), float(hz[a]))
             k = max(1, int(round(spc / target)))
             decimation.setdefault(cond[1], k)
-            runs = _complete_runs(g["phase"].to_numpy(float), g["cycle"].to_numpy())
-            block = g[columns].to_numpy(dtype=np.float64)[::k]
-            blocks.append(block)
-            tids.append(int(tid))
+            runs_out.append(_complete_runs(values[a:b, ph_col], values[a:b, cy_col]))
+            keep[a:b:k] = True
             starts.append(row)
-            row += len(block)
+            row += len(range(a, b, k))
             stops.append(row)
             conds_out.append(cond)
-            runs_out.append(runs)
+        tids = trial[lo]
         return cls(
-            values=np.ascontiguousarray(np.concatenate(blocks)),
+            values=np.ascontiguousarray(values[keep]),
             columns=tuple(columns),
             trial_ids=np.asarray(tids, dtype=np.int64),
             row_start=np.asarray(starts, dtype=np.int64),

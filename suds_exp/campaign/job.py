@@ -100,9 +100,11 @@ def run_draw(
         try:
             model = make_model(name, **params)
             t0 = time.perf_counter()
-            model.fit(train.copy())
+            # Shallow copies: pandas copies on write, so a learner that adds or overwrites
+            # columns changes only its own copy and the next learner sees the same frame.
+            model.fit(train.copy(deep=False))
             t1 = time.perf_counter()
-            pred = model.predict(test.copy())
+            pred = model.predict(test.copy(deep=False))
             t2 = time.perf_counter()
             fit_s, predict_s = t1 - t0, t2 - t1
             err = np.column_stack([pred[c].to_numpy(dtype=float) for c in VB]) - truth
