@@ -4,6 +4,11 @@ and agreement between the views and the Python tables."""
 from __future__ import annotations
 
 import itertools
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
 
 import duckdb
 import numpy as np
@@ -12,6 +17,7 @@ import pytest
 
 from suds_exp.analysis import AnalysisError, iqr_table, load_results, synthetic_results
 from suds_exp.store import Store
+from suds_exp.store.migrate import available_migrations
 
 GAITS = ["S+", "S-", "O", "D-", "D+"]
 FREQS = [0.333333, 0.5, 1.0]
@@ -115,3 +121,42 @@ def test_failed_jobs_are_left_out_and_unknown_campaigns_refused(store):
     with pytest.raises(AnalysisError, match="'nope'.*grid"):
         load_results(store, "nope")
     assert isinstance(load_results(store, "grid"), pd.DataFrame)
+
+
+def test_views_run_in_the_stock_duckdb_shell(tmp_path):
+    search = os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])
+    shell = shutil.which("duckdb", path=search)
+    if shell is None:
+        pytest.skip("no duckdb shell on PATH (the dev extras install it: duckdb-cli)")
+    # The shell can be older than the Python library; this file is written in the oldest
+    # storage format both read, because the test is about the views' SQL, not the format.
+    path = tmp_path / "shell.duckdb"
+    con = duckdb.connect(str(path), config={"storage_compatibility_version": "v1.0.0"})
+    try:
+        for migration in available_migrations():
+            con.execute(migration.sql)
+        rows = synthetic_results("grid", n_boot=1, seed=3)
+        con.register("new_rows", rows)
+        con.execute("INSERT INTO results BY NAME SELECT * FROM new_rows")
+    finally:
+        con.close()
+    sql = (
+        "SELECT gait_sim, period_rel, count(*) AS n FROM results_labelled GROUP BY ALL "
+        "ORDER BY ALL; SELECT count(*) AS n FROM results_iqr; SELECT count(*) AS n FROM "
+        "results_categories;"
+    )
+    out = subprocess.run(
+        [shell, "-readonly", "-csv", str(path), "-c", sql],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.split()
+    # 5 learners x 25 gait pairs (5 same, 8 near, 12 far) x 9 frequency pairs, of which
+    # each period relation <, =, > holds 3.
+    expected = [
+        f"{g},{p},{5 * k * 3}" for g, k in (("far", 12), ("near", 8), ("same", 5)) for p in "<=>"
+    ]
+    assert lines[:10] == ["gait_sim,period_rel,n", *expected]
+    assert lines[10:] == ["n", str(2 * 3 * 5), "n", str(5 * 2 * 3)]
