@@ -59,11 +59,11 @@ Branching: the map may be multi-valued, the body moving differently at one
 Measured (benchmarks/models.py ablation, 30 cycles of O at 1/2 Hz, 3 draws): "filter"
 changes the error by less than 3 % anywhere: with dr_a/dt among the inputs a periodic
 gait never revisits an (r_a, dr_a/dt) point, so gating on x alone is already
-unambiguous. "history" helps on the training gait (synthetic swimmer: GMR -16 % same
-condition, -14 % at 1 Hz; simulator: GMR+SUDS -16 % same condition, -25 % at 1 Hz) but
-costs +3 to +50 % on another gait (D+), whose history chords lie outside the training
-data. Since most pairs of a campaign cross gaits, both stay available and off by
-default.
+unambiguous. "history" often helps on the training gait (synthetic swimmer: GMR -16 %
+same condition, -14 % at 1 Hz; simulator: GMR+SUDS -16 % same condition, -25 % at 1 Hz;
+but simulator GMR +9 % same condition) and costs +3 to +50 % on another gait (D+),
+whose history chords lie outside the training data. Since most pairs of a campaign
+cross gaits, both stay available and off by default.
 
 Rollout (GMR+SUDS, mode="rollout"): r_p starts at each trial's first measured value and
 is integrated by explicit Euler with the predicted dr_p/dt, clipped to the training range
