@@ -104,3 +104,16 @@ def test_gmr_suds_rollout_follows_the_passive_trajectory():
     # without the passive dynamics (r_p frozen at its start) it would be far worse
     frozen = np.sqrt(((truth - truth[0]) ** 2).mean(axis=0))
     assert (rms < 0.3 * frozen).all()
+
+
+def test_a_robot_standing_still_predicts_no_motion():
+    """Most of the trial at rest (median shape speed 0): no division by zero, and zero
+    shape velocity gives zero body velocity under the homogeneous augmentation."""
+    train = make_samples(5, seed=1)
+    rest = train.index < 0.6 * len(train)
+    still = train.copy()
+    still.loc[rest, ["dra_1", "dra_2", "vx", "vy", "wz", "drp_1", "drp_2"]] = 0.0
+    for name in ("GMR", "GMR+SUDS"):
+        pred = make_model(name).fit(still).predict(still)
+        assert np.isfinite(pred.to_numpy()).all()
+        assert np.abs(pred[rest].to_numpy()).max() < 1e-9

@@ -270,7 +270,9 @@ class GMR(Learner):
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
         rng = np.random.default_rng(self.random_state)
         speed = np.linalg.norm(as_array(samples, DRA_COLUMNS, self.name), axis=1)
-        self.speed_floor_ = self.speed_floor * float(np.median(speed))
+        # a robot that mostly stands still has median speed 0: fall back to the mean, then 1
+        typical = float(np.median(speed)) or float(np.mean(speed)) or 1.0
+        self.speed_floor_ = self.speed_floor * typical
         Xin, f = self._inputs(samples)
         Z = np.hstack([Xin, as_array(samples, cout, self.name) / f[:, None]])
         names = cin + (["hist_1", "hist_2"] if self.branching == "history" else []) + cout
