@@ -8,6 +8,7 @@ heights are world Z above the bed surface (`Measurement.*_height_mm`).
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -102,6 +103,19 @@ def rigid_marker_positions(
     return out
 
 
+@functools.lru_cache(maxsize=64)
+def _spoke_filter(freq_hz: float, zeta: float, gain: float, dt: float):
+    """(num, den) of the zero-order-hold discretised spoke oscillator."""
+    w = 2 * math.pi * freq_hz
+    A = np.array([[0.0, 1.0], [-w * w, -2 * zeta * w]])
+    B = np.array([[0.0], [-gain]])
+    C = np.array([[1.0, 0.0]])
+    D = np.array([[0.0]])
+    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), dt, method="zoh")
+    num, den = ss2tf(Ad, Bd, Cd, Dd)
+    return np.ravel(num), np.ravel(den)
+
+
 def spoke_deflection(cfg: SimConfig, base_xy: np.ndarray, dt: float) -> np.ndarray:
     """Parasitic oscillation of a raised spoke marker, mm, array (n, 2).
 
@@ -114,15 +128,8 @@ def spoke_deflection(cfg: SimConfig, base_xy: np.ndarray, dt: float) -> np.ndarr
     if eff.gain == 0 or n < 3:
         return np.zeros((n, 2))
     acc = np.gradient(np.gradient(base_xy, dt, axis=0), dt, axis=0)
-    w = 2 * math.pi * eff.freq_hz
-    zeta = eff.damping_ratio
-    A = np.array([[0.0, 1.0], [-w * w, -2 * zeta * w]])
-    B = np.array([[0.0], [-eff.gain]])
-    C = np.array([[1.0, 0.0]])
-    D = np.array([[0.0]])
-    Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), dt, method="zoh")
-    num, den = ss2tf(Ad, Bd, Cd, Dd)
-    return lfilter(np.ravel(num), np.ravel(den), acc, axis=0)
+    num, den = _spoke_filter(eff.freq_hz, eff.damping_ratio, eff.gain, dt)
+    return lfilter(num, den, acc, axis=0)
 
 
 def true_marker_positions(
