@@ -310,9 +310,9 @@ def status(
 @command()
 def report(
     name: Annotated[str, typer.Argument(help="Campaign name.")],
-    out: Annotated[Path | None, typer.Option(help="Folder [default: reports/NAME].")] = None,
+    out: Annotated[Path | None, typer.Option(help="Folder (default: reports/NAME).")] = None,
     cycles: Annotated[
-        int | None, typer.Option(help="Training size of box plots and GLMs [default: most common].")
+        int | None, typer.Option(help="Training size of box plots and GLMs (default: most common).")
     ] = None,
     pairs: Annotated[
         str, typer.Option(help="Spread/efficiency pairs: same-condition or same-frequency.")
