@@ -158,7 +158,7 @@ class TLS(Learner):
         Regressor directions whose squared singular value is not above tls_gap times the
         TLS noise level are truncated (> 1; large values approach principal-component
         regression, values near 1 plain TLS).
-    min_spread : float, default 0.02
+    min_spread : float, default 0.05
         Regressor directions whose RMS spread inside a bin is below this fraction of the
         gait's excursion are dropped (not identifiable from the bin).
     ridge : float, default 0.0
@@ -190,7 +190,7 @@ class TLS(Learner):
         coef_order: int = 3,
         min_bin_factor: float = 2.0,
         tls_gap: float = 2.0,
-        min_spread: float = 0.02,
+        min_spread: float = 0.05,
         ridge: float = 0.0,
     ):
         self.n_bins = n_bins
@@ -367,7 +367,7 @@ class TLSSuds(TLS):
         coef_order: int = 3,
         min_bin_factor: float = 2.0,
         tls_gap: float = 2.0,
-        min_spread: float = 0.02,
+        min_spread: float = 0.05,
         ridge: float = 0.0,
         mode: str = "measured",
     ):
