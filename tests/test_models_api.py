@@ -123,3 +123,12 @@ def test_a_gap_inside_a_trial_restarts_the_series(data):
     for name in ("TLS+SUDS", "GMR+SUDS"):
         m = make_model(name, mode="rollout").fit(train)
         np.testing.assert_allclose(m.predict(cut), m.predict(as_two), rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_every_hyper_parameter_lands_in_its_own_attribute(name):
+    """Subclasses forward their parameters positionally; a swapped pair would go unseen
+    by the round-trip test, so set each to a distinct marker and read it back."""
+    params = make_model(name).get_params()
+    marked = {p: f"marker-{p}" for p in params}
+    assert make_model(name, **marked).get_params() == marked
