@@ -93,6 +93,12 @@ _PAIRS_TEXT = {
     "same-frequency": "Results trained and tested at the same frequency, gait pairings pooled",
 }
 
+_NAV = (
+    '<p><a href="#categories">box plots</a> | <a href="#glm">GLM</a> | '
+    '<a href="#spread">spread</a> | <a href="#efficiency">sample efficiency</a> | '
+    '<a href="#paper">beside the paper</a></p>'
+)
+
 _CSS = """
 body { font-family: sans-serif; max-width: 1400px; margin: 1em auto; padding: 0 1em; color: #222; }
 img { max-width: 100%; border: 1px solid #ddd; margin: 0.5em 0; }
@@ -218,7 +224,8 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         f"learners {esc(models)}; "
         f"training sizes (cycles) {esc(sizes)}. Box plots and GLMs use the {size}-cycle results. "
         f"Written {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.</p>",
-        "<h2>1. Log RMS error by similarity category</h2>",
+        _NAV,
+        '<h2 id="categories">1. Log RMS error by similarity category</h2>',
         '<p class="note">Gait similarity: steps between training and test gait on the axis '
         "S+, S-, O, D-, D+ (same 0, near 1, far more than 1). Frequency: same or different "
         "training and test frequency. Box plots with matplotlib's default parameters.</p>",
@@ -229,7 +236,7 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         "<h3>Numbers behind the box plots (ln of mm/s)</h3>",
         f"<p>Files: {_files(files['categories'])}</p>",
         to_html(tables["categories"], 3),
-        "<h2>2. GLM of log RMS error</h2>",
+        '<h2 id="glm">2. GLM of log RMS error</h2>',
         f"<p>Response: <code>y = {esc(glm.attrs['response'])}</code> (a coefficient of -10 is "
         "about 10 % less error; independent of the error's unit). Gaussian GLM, identity link, "
         f"{glm.attrs['n_rows']} learner results at {size} cycles, phase-only left out "
@@ -265,7 +272,7 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         parts.append(to_html(raw[raw["model"] == label].drop(columns="model"), 2))
     parts.append(f"<p>Files: {_files(files['glm_rmse'])}</p>")
 
-    parts.append("<h2>3. Spread: IQR of RMS error of vx</h2>")
+    parts.append('<h2 id="spread">3. Spread: IQR of RMS error of vx</h2>')
     if "iqr" in tables:
         parts.append(
             f'<p class="note">{_PAIRS_TEXT[pairs]}, by learner (rows) and training cycles '
@@ -275,7 +282,7 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
             parts += [f"<h3>{plots.frequency_name(freq)} Hz</h3>", to_html(wide, 2)]
         parts.append(f"<p>Files (long form, with quartiles and counts): {_files(files['iqr'])}</p>")
         parts += [
-            "<h2>4. Sample efficiency</h2>",
+            '<h2 id="efficiency">4. Sample efficiency</h2>',
             f'<img src="{esc(figures["sample_efficiency"].name)}" alt="sample_efficiency">',
             '<p class="note">Median (line) and IQR (band) of the RMS error against training '
             "cycles, log-log. Slope: least squares of ln RMS error on ln cycles over the "
@@ -290,7 +297,7 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
             "sample-efficiency figure.</p>"
         )
 
-    parts.append("<h2>5. Beside the paper</h2>")
+    parts.append('<h2 id="paper">5. Beside the paper</h2>')
     if "compare_glm" in tables:
         parts += [
             '<p class="note">The paper\'s rows with our numbers beside them. Sign agreement per '
