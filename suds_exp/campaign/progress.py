@@ -43,7 +43,7 @@ def job_progress(
         MofNCompleteColumn(),
         _RateColumn(),
         TimeElapsedColumn(),
-        TextColumn("left"),
+        TextColumn("eta"),
         TimeRemainingColumn(),
     )
     with Progress(*columns, console=console.err, transient=False, speed_estimate_period=120) as bar:
