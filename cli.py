@@ -224,6 +224,53 @@ def effects(
 
 
 @command()
+def preprocess(
+    name: Annotated[str | None, typer.Option(help="Name of a new version [v<id>].")] = None,
+    param: Annotated[
+        list[str] | None, typer.Option("--param", help="KEY=VALUE over the defaults; repeatable.")
+    ] = None,
+    trials_: Annotated[
+        str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 [all].")
+    ] = None,
+    list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Turn markers into samples (shape, phase, body velocity) as a stored version.
+
+    The same parameters are the same version: re-running skips the trials already done.
+    Example: suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-20
+    """
+    from suds_exp.preprocess import list_versions, parse_param_items, parse_trial_ids
+    from suds_exp.preprocess import preprocess as run_preprocess
+
+    store = open_store(db)
+    if list_:
+        frame = list_versions(store)
+        if json_:
+            console.print_json(frame)
+        else:
+            shown = frame.drop(columns=["params"]).assign(params_hash=frame.params_hash.str[:12])
+            console.print_frame(shown, title="preprocessing versions")
+        return
+    result = run_preprocess(
+        store, name, parse_param_items(param or []), parse_trial_ids(trials_),
+        progress=not (quiet or json_),
+    )
+    if json_:
+        console.print_json(result.to_dict())
+        return
+    ev = ", ".join(f"{100 * r:.1f}%" for r in result.explained_variance_ratio)
+    console.out.print(
+        f"version {result.version_id} ({result.name}, params {result.params_hash[:12]}): "
+        f"{'created' if result.created else 'reused'}; processed {len(result.processed)} "
+        f"trials ({result.n_samples} samples), skipped {len(result.skipped)} already done, "
+        f"in {result.seconds:.1f} s; passive PCs explain {ev}"
+    )
+
+
+@command()
 def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
     prep: Annotated[str | None, typer.Option(help="Preprocessing version of the samples.")] = None,
@@ -335,6 +382,62 @@ def report(
         console.print_json({"index": str(index), "files": files})
     else:
         console.out.print(f"wrote {index}")
+
+
+@command()
+def discrepancy(
+    model: Annotated[
+        Path | None, typer.Option("--model", help="Starting simulator config [nominal].")
+    ] = None,
+    model_effect: Annotated[
+        list[str] | None,
+        typer.Option("--model-effect", help="NAME=VALUE on the starting model; repeatable."),
+    ] = None,
+    trials: Annotated[str | None, typer.Option(help="Comma list of trial ids [all].")] = None,
+    prep: Annotated[str | None, typer.Option(help="Preprocessing version [the only one].")] = None,
+    alpha: Annotated[float, typer.Option(help="Level of the test naming an effect.")] = 0.01,
+    max_effects: Annotated[int, typer.Option(help="Stop after naming this many.")] = 3,
+    seed: Annotated[int, typer.Option(help="Seed of the trial split and bootstraps.")] = 0,
+    name: Annotated[str | None, typer.Option(help="Run name [discrepancy-<time>].")] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="Report folder [reports/discrepancy-NAME].")
+    ] = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Replay the trials through the simulator, find where they disagree, name the missing
+    effects (fitted on half the trials, tested on the other half) and report the gap.
+
+    Example: suds-exp discrepancy --model-effect flippers=absent --max-effects 2
+    """
+    from suds_exp.discrepancy import DiscrepancyOptions, parse_trial_ids, run_discrepancy
+    from suds_exp.sim.commands import build_config
+
+    start = build_config(model, model_effect or [])
+    say = (lambda line: None) if (quiet or json_) else console.err.print
+    result = run_discrepancy(
+        open_store(db),
+        prep,
+        start,
+        name=name,
+        trials=parse_trial_ids(trials),
+        options=DiscrepancyOptions(alpha=alpha, max_effects=max_effects, seed=seed),
+        out=out,
+        default_out=Path("reports"),
+        log=say,
+    )
+    if json_:
+        console.print_json(result.to_json())
+        return
+    for n in result.named:
+        console.out.print(
+            f"step {n['step']}: {n['candidate']} {n['parameter'] or ''} = {n['value']} "
+            f"{n['unit']} {n['ci']} (p_adj {n['p_adjusted']:.2g}); "
+            f"held-out loss {n['gap_before']:.4g} -> {n['gap_after']:.4g}"
+        )
+    console.out.print(result.outcome)
+    console.out.print(f"report: {result.report_dir}")
 
 
 @command()

@@ -1,0 +1,31 @@
+"""Discrepancy workflow: replay measured trials through the simulator, localise the gap,
+fit and test the simulator's named effects as candidates, name the one that significantly
+closes the held-out gap, add it and repeat."""
+
+from suds_exp.discrepancy.demo import demo_discrepancy, draw_hidden, hidden_effect_run
+from suds_exp.discrepancy.effects import Candidate, candidates_for, parse_effect_items
+from suds_exp.discrepancy.errors import DiscrepancyError
+from suds_exp.discrepancy.replay import ReplaySettings
+from suds_exp.discrepancy.select import FitSettings
+from suds_exp.discrepancy.workflow import (
+    DiscrepancyOptions,
+    DiscrepancyResult,
+    parse_trial_ids,
+    run_discrepancy,
+)
+
+__all__ = [
+    "Candidate",
+    "DiscrepancyError",
+    "DiscrepancyOptions",
+    "DiscrepancyResult",
+    "FitSettings",
+    "ReplaySettings",
+    "candidates_for",
+    "demo_discrepancy",
+    "draw_hidden",
+    "hidden_effect_run",
+    "parse_effect_items",
+    "parse_trial_ids",
+    "run_discrepancy",
+]

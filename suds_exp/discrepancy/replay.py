@@ -1,0 +1,322 @@
+"""Replay: drive the simulator with each measured trial's own actuated shape r_a(t).
+
+Cost is what shapes this module. A candidate fit needs the simulator's answer for many
+parameter values on many trials, so the replay runs on short windows (a few cycles of
+each trial), at a fixed number of samples per gait cycle (the quasi-static physics does
+not need 100 Hz), and stacks every window x configuration of one evaluation into one
+simulator call per frame interval.
+
+A window starts with a warm-up (flipper angles and the body-inertia state forget their
+unknown initial values) and is scored after it. To compare like with like, the replay's
+body velocity goes through the same differentiator as the measurement: the simulated
+pose is interpolated back to the capture rate and differentiated with the
+preprocessing version's Savitzky-Golay filter; the replayed r_a is the measured one,
+smoothed by the same filter so marker noise does not drive the physics.
+
+`medium_compaction` depends on the distance travelled since the start of the trial; a
+window starting after distance d0 (measured, m) is replayed with the exactly equivalent
+parameters normal_scale * (1 + c d0) and c / (1 + c d0) (adapter: the simulator starts
+every trial at distance 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.interpolate import CubicSpline
+from scipy.signal import savgol_filter
+
+from suds_exp.sim.config import SimConfig
+from suds_exp.sim.mechanics import simulate_prescribed
+
+CHANNELS = ("vx", "vy", "wz")
+
+
+@dataclass(frozen=True)
+class ReplaySettings:
+    """How measured trials are cut into replay windows.
+
+    Parameters
+    ----------
+    windows_per_trial : int
+        Windows per trial, spread evenly over its length.
+    cycles_per_window : float
+        Scored length of each window, gait cycles.
+    warmup_cycles : float
+        Replayed but not scored before each window, gait cycles.
+    samples_per_cycle : int
+        Simulator steps per gait cycle (the decimation; 100 Hz capture at 1 Hz is 100).
+    sg_window_s, sg_window_cycles, sg_polyorder : float, float, int
+        The preprocessing version's Savitzky-Golay differentiator: window in s, or in
+        gait cycles when ``sg_window_cycles`` > 0, and its order.
+    solver_tol : float
+        Scaled residual tolerance of the simulator's per-step solve during replay.
+    ra_smooth_s : float
+        Savitzky-Golay smoothing window (s) applied to the measured r_a before it drives
+        the replay, against marker noise; 0 replays it as measured.
+    """
+
+    windows_per_trial: int = 2
+    cycles_per_window: float = 1.0
+    warmup_cycles: float = 1.0
+    samples_per_cycle: int = 40
+    sg_window_s: float = 0.21
+    sg_window_cycles: float = 0.0
+    sg_polyorder: int = 3
+    solver_tol: float = 1e-7
+    ra_smooth_s: float = 0.0
+
+
+@dataclass
+class WindowGroup:
+    """Windows sharing one simulator frame interval (same frequency).
+
+    Arrays: ``phi`` (n, n_steps, 2) rad, decimated smoothed r_a from the warm-up start;
+    ``measured`` (n, n_scored, 3) vx, vy mm/s, wz rad/s; ``phase`` (n, n_scored) rad;
+    ``ra`` (n, n_scored, 2) rad; ``t`` (n, n_scored) s within the trial; ``d0`` (n,) m
+    travelled before the window's replay starts.
+    """
+
+    dt: float
+    step: int
+    index: np.ndarray
+    phi: np.ndarray
+    measured: np.ndarray
+    phase: np.ndarray
+    ra: np.ndarray
+    t: np.ndarray
+    d0: np.ndarray
+    n_fine: int
+    score_from: int
+    n_scored: int
+    sg_frames: int
+
+
+@dataclass
+class WindowSet:
+    """Replay windows over trials. ``trial_id`` (n_windows,), and groups by frame interval.
+
+    ``info`` is a frame with one row per window: trial_id, gait, frequency_hz, t_start,
+    t_rel (window centre over trial length, 0..1).
+    """
+
+    info: pd.DataFrame
+    groups: list[WindowGroup]
+    settings: ReplaySettings
+
+    @property
+    def trial_id(self) -> np.ndarray:
+        return self.info["trial_id"].to_numpy()
+
+    def subset(self, trials) -> WindowSet:
+        """The windows of the given trial ids only."""
+        keep = np.isin(self.trial_id, np.asarray(list(trials)))
+        new_index = np.cumsum(keep) - 1
+        groups = []
+        for g in self.groups:
+            m = keep[g.index]
+            if not m.any():
+                continue
+            groups.append(
+                WindowGroup(
+                    g.dt,
+                    g.step,
+                    new_index[g.index[m]],
+                    g.phi[m],
+                    g.measured[m],
+                    g.phase[m],
+                    g.ra[m],
+                    g.t[m],
+                    g.d0[m],
+                    g.n_fine,
+                    g.score_from,
+                    g.n_scored,
+                    g.sg_frames,
+                )
+            )
+        return WindowSet(self.info[keep].reset_index(drop=True), groups, self.settings)
+
+
+def settings_from_prep(params: dict, **overrides) -> ReplaySettings:
+    """Replay settings matching a preprocessing version's parameters (its differentiator)."""
+    return ReplaySettings(
+        sg_window_s=float(params.get("sg_window_s", 0.21)),
+        sg_window_cycles=float(params.get("sg_window_cycles", 0.0)),
+        sg_polyorder=int(params.get("sg_polyorder", 3)),
+        **overrides,
+    )
+
+
+def _odd_window(window_s: float, dt: float, polyorder: int) -> int:
+    w = max(int(round(window_s / dt)), polyorder + 2)
+    return w + 1 - w % 2
+
+
+def make_windows(samples: pd.DataFrame, settings: ReplaySettings | None = None) -> WindowSet:
+    """Cut measured trials into replay windows.
+
+    Parameters
+    ----------
+    samples : DataFrame
+        Samples frame (`suds_exp.preprocess.load_samples`): trial_id, t (s), phase (rad),
+        ra_1, ra_2 (rad), vx, vy (mm/s), wz (rad/s), gait, frequency_hz.
+    settings : ReplaySettings, optional
+    """
+    s = settings or ReplaySettings()
+    rows, per_group = [], {}
+    for trial_id, tr in samples.sort_values(["trial_id", "t"]).groupby("trial_id", sort=True):
+        t = tr["t"].to_numpy(float)
+        if len(t) < 8:
+            continue
+        dt_cap = float(np.median(np.diff(t)))
+        freq = float(tr["frequency_hz"].iloc[0])
+        period_frames = 1.0 / (freq * dt_cap)
+        step = max(1, int(round(period_frames / s.samples_per_cycle)))
+        sg_s = s.sg_window_cycles / freq if s.sg_window_cycles > 0 else s.sg_window_s
+        sg = _odd_window(sg_s, dt_cap, s.sg_polyorder)
+        half = sg // 2
+        n_warm = int(round(s.warmup_cycles * period_frames / step)) * step
+        n_score = int(round(s.cycles_per_window * period_frames))
+        # the replay runs half a filter window past the scored end so the
+        # differentiator sees the same neighbourhood as the measurement's did
+        n_tail = int(np.ceil(half / step)) * step
+        n_total = n_warm + n_score + n_tail
+        n_total = int(np.ceil((n_total - 1) / step)) * step + 1
+        if len(t) < n_total:
+            continue
+        ra = tr[["ra_1", "ra_2"]].to_numpy(float)
+        ra_s = ra
+        if s.ra_smooth_s > 0:
+            w = min(_odd_window(s.ra_smooth_s, dt_cap, s.sg_polyorder), len(t) - 1 + len(t) % 2)
+            ra_s = savgol_filter(ra, w, s.sg_polyorder, axis=0)
+        meas = tr[list(CHANNELS)].to_numpy(float)
+        speed = np.hypot(meas[:, 0], meas[:, 1])
+        # path length from the trial's start (mm -> m); before the first kept sample
+        # the robot is assumed to have moved at its mean speed
+        dist = (
+            np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))])
+            + np.nanmean(speed) * t[0]
+        ) / 1000.0
+        starts = np.linspace(0, len(t) - n_total, s.windows_per_trial + 2)[1:-1]
+        if s.windows_per_trial == 1:
+            starts = np.array([(len(t) - n_total) / 2])
+        key = (round(dt_cap * step, 9), step, n_total, n_warm, n_score, sg)
+        for a in np.round(starts).astype(int):
+            sc = slice(a + n_warm, a + n_warm + n_score)
+            g = per_group.setdefault(key, [])
+            g.append(
+                (
+                    len(rows),
+                    ra_s[a : a + n_total : step],
+                    meas[sc],
+                    tr["phase"].to_numpy(float)[sc],
+                    ra[sc],
+                    t[sc],
+                    dist[a],
+                )
+            )
+            rows.append(
+                {
+                    "trial_id": int(trial_id),
+                    "gait": tr["gait"].iloc[0],
+                    "frequency_hz": freq,
+                    "t_start": float(t[a + n_warm]),
+                    "t_rel": float((t[sc][len(t[sc]) // 2] - t[0]) / max(t[-1] - t[0], 1e-9)),
+                }
+            )
+    groups = []
+    for (dt, step, n_total, n_warm, n_score, sg), items in per_group.items():
+        idx, phi, meas, phase, ra, tt, d0 = zip(*items, strict=True)
+        groups.append(
+            WindowGroup(
+                dt=dt,
+                step=step,
+                index=np.array(idx),
+                phi=np.stack(phi),
+                measured=np.stack(meas),
+                phase=np.stack(phase),
+                ra=np.stack(ra),
+                t=np.stack(tt),
+                d0=np.array(d0),
+                n_fine=n_total,
+                score_from=n_warm,
+                n_scored=n_score,
+                sg_frames=sg,
+            )
+        )
+    return WindowSet(pd.DataFrame(rows), groups, s)
+
+
+def _window_config(cfg: SimConfig, d0_m: float, tol: float) -> SimConfig:
+    out = cfg.copy()
+    out.solver.tol = tol
+    c = cfg.effects.medium_compaction.rate_per_m
+    if c > 0 and d0_m > 0:
+        grow = 1.0 + c * d0_m
+        out.effects.drag_anisotropy.normal_scale = cfg.effects.drag_anisotropy.normal_scale * grow
+        out.effects.medium_compaction.rate_per_m = c / grow
+    return out
+
+
+def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
+    """Simulated body velocity of every window under every configuration.
+
+    Parameters
+    ----------
+    windows : WindowSet
+    configs : list of n_configs SimConfig
+
+    Returns
+    -------
+    array of shape (n_configs, n_windows, n_scored_max, 3)
+        vx, vy (mm/s), wz (rad/s), body frame, through the measurement's differentiator;
+        NaN past a window's scored length.
+    """
+    n_win = len(windows.info)
+    n_max = max((g.n_scored for g in windows.groups), default=0)
+    out = np.full((len(configs), n_win, n_max, 3), np.nan)
+    s = windows.settings
+    for g in windows.groups:
+        n = len(g.index)
+        batch_cfg = [
+            _window_config(c, float(g.d0[k]), s.solver_tol) for c in configs for k in range(n)
+        ]
+        phi = np.tile(g.phi, (len(configs), 1, 1))
+        sim = simulate_prescribed(phi, g.dt, batch_cfg)
+        pose = sim["pose"]  # (n_cfg * n, n_steps, 3)
+        coarse_t = np.arange(pose.shape[1]) * g.step
+        fine_t = np.arange(g.n_fine)
+        fine = CubicSpline(coarse_t, pose, axis=1)(fine_t)
+        dt_cap = g.dt / g.step
+        rates = savgol_filter(
+            fine, g.sg_frames, s.sg_polyorder, deriv=1, delta=dt_cap, axis=1, mode="interp"
+        )
+        sc = slice(g.score_from, g.score_from + g.n_scored)
+        heading = fine[:, sc, 2]
+        c, sn = np.cos(heading), np.sin(heading)
+        vx = c * rates[:, sc, 0] + sn * rates[:, sc, 1]
+        vy = -sn * rates[:, sc, 0] + c * rates[:, sc, 1]
+        vel = np.stack([vx, vy, rates[:, sc, 2]], axis=-1).reshape(len(configs), n, g.n_scored, 3)
+        out[:, g.index, : g.n_scored] = vel
+    return out
+
+
+def measured(windows: WindowSet) -> np.ndarray:
+    """Measured body velocity of every window, (n_windows, n_scored_max, 3), NaN padded."""
+    n_max = max((g.n_scored for g in windows.groups), default=0)
+    out = np.full((len(windows.info), n_max, 3), np.nan)
+    for g in windows.groups:
+        out[g.index, : g.n_scored] = g.measured
+    return out
+
+
+def window_field(windows: WindowSet, name: str) -> np.ndarray:
+    """A per-sample field (``phase``, ``t``, ``ra``) of every window, NaN padded."""
+    n_max = max((g.n_scored for g in windows.groups), default=0)
+    first = getattr(windows.groups[0], name)
+    out = np.full((len(windows.info), n_max, *first.shape[2:]), np.nan)
+    for g in windows.groups:
+        out[g.index, : g.n_scored] = getattr(g, name)
+    return out

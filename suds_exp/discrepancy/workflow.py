@@ -1,0 +1,474 @@
+"""The discrepancy workflow: replay, localise, try candidates, name one, add it, repeat.
+
+`run_discrepancy` is the library face of `suds-exp discrepancy`. Trials are split once,
+by trial and stratified by condition, into a training half (candidate fits) and a
+held-out half (scores and tests); every number about "the gap" is held-out.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import json
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.discrepancy.effects import Candidate, candidates_for
+from suds_exp.discrepancy.errors import DiscrepancyError
+from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
+from suds_exp.discrepancy.replay import (
+    ReplaySettings,
+    WindowSet,
+    make_windows,
+    measured,
+    replay,
+    settings_from_prep,
+    window_field,
+)
+from suds_exp.discrepancy.select import (
+    CandidateResult,
+    FitSettings,
+    fit_candidate,
+    refine_candidate,
+    score_candidates,
+    trial_losses,
+)
+from suds_exp.sim.config import SimConfig
+
+
+@dataclass
+class DiscrepancyOptions:
+    """Everything that shapes a run (stored with it).
+
+    Parameters
+    ----------
+    alpha : float
+        Level of the paired test naming an effect (Bonferroni over the candidates).
+    max_effects : int
+        Stop after naming this many effects.
+    seed : int
+        Seed of the trial split and the bootstraps.
+    replay : ReplaySettings, optional
+        Window cutting; None: defaults with the preprocessing version's differentiator.
+    fit : FitSettings
+    refine : bool
+        Re-fit the accepted candidate's parameter at the capture rate (no decimation), so
+        its value and interval are not biased by the replay's discretisation.
+    gap_floor : float
+        Held-out loss (mean squared residual over each channel's mean square, so 0.01 is
+        a residual of about 10% of the signal) below which a remaining gap is called
+        negligible even when it is statistically systematic.
+    """
+
+    alpha: float = 0.01
+    max_effects: int = 3
+    seed: int = 0
+    replay: ReplaySettings | None = None
+    fit: FitSettings = field(default_factory=FitSettings)
+    refine: bool = True
+    gap_floor: float = 0.01
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+@dataclass
+class Step:
+    """One pass of the loop: the model replayed, its gap, the candidates, the decision."""
+
+    index: int
+    model: SimConfig
+    test_loss: float
+    test_rmse: np.ndarray
+    test_trial_loss: np.ndarray
+    localisation: pd.DataFrame
+    candidates: list[CandidateResult] = field(default_factory=list)
+    unobservable: list[str] = field(default_factory=list)
+    accepted: CandidateResult | None = None
+    decision: str = "none_significant"
+    gap_closed: float | None = None
+    systematic: tuple[float, float] = (float("nan"), 1.0)
+    correlations: pd.DataFrame | None = None
+    example: dict | None = None
+
+
+@dataclass
+class DiscrepancyResult:
+    """Outcome of a run. ``named`` lists the accepted effects in order."""
+
+    run_id: int | None
+    name: str
+    prep_version: str | None
+    steps: list[Step]
+    train_trials: list[int]
+    test_trials: list[int]
+    start_model: SimConfig
+    final_model: SimConfig
+    outcome: str
+    seconds: float
+    report_dir: Path | None = None
+
+    @property
+    def named(self) -> list[dict]:
+        out = []
+        for s in self.steps:
+            a = s.accepted
+            if a is None:
+                continue
+            out.append(
+                {
+                    "step": s.index,
+                    "effect": a.candidate.effect,
+                    "candidate": a.candidate.label,
+                    "parameter": a.candidate.param,
+                    "value": a.value,
+                    "ci": list(a.ci) if a.ci is not None else None,
+                    "unit": a.candidate.unit,
+                    "p_adjusted": a.p_adjusted,
+                    "gap_before": s.test_loss,
+                    "gap_after": self.steps[s.index + 1].test_loss
+                    if s.index + 1 < len(self.steps)
+                    else None,
+                    "gap_closed": s.gap_closed,
+                }
+            )
+        return out
+
+    @property
+    def gap_before(self) -> float:
+        """Held-out loss of the starting model (mean normalised squared residual)."""
+        return self.steps[0].test_loss
+
+    @property
+    def gap_after(self) -> float:
+        """Held-out loss of the final model."""
+        return self.steps[-1].test_loss
+
+    def to_json(self) -> dict:
+        last = self.steps[-1]
+        return {
+            "run_id": self.run_id,
+            "name": self.name,
+            "prep_version": self.prep_version,
+            "named": self.named,
+            "gap_before": self.gap_before,
+            "gap_after": self.gap_after,
+            "rmse_vx_before": float(self.steps[0].test_rmse[0]),
+            "rmse_vx_after": float(last.test_rmse[0]),
+            "steps": [
+                {
+                    "step": s.index,
+                    "test_loss": s.test_loss,
+                    "test_rmse": dict(
+                        zip(("vx", "vy", "wz"), map(float, s.test_rmse), strict=True)
+                    ),
+                    "decision": s.decision,
+                    "accepted": s.accepted.candidate.label if s.accepted else None,
+                    "candidates": [
+                        {
+                            "candidate": r.candidate.label,
+                            "value": r.value,
+                            "ci": list(r.ci) if r.ci else None,
+                            "improvement": r.improvement,
+                            "p_adjusted": r.p_adjusted,
+                            "significant": r.significant,
+                        }
+                        for r in s.candidates
+                    ],
+                    "unobservable": s.unobservable,
+                    "systematic_p": s.systematic[1],
+                }
+                for s in self.steps
+            ],
+            "outcome": self.outcome,
+            "seconds": self.seconds,
+            "report_dir": str(self.report_dir) if self.report_dir else None,
+            "train_trials": self.train_trials,
+            "test_trials": self.test_trials,
+        }
+
+
+def parse_trial_ids(text: str | None) -> list[int] | None:
+    """``"3,5,8"`` -> [3, 5, 8]; None -> None (all trials)."""
+    if text is None or not text.strip():
+        return None
+    try:
+        return [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DiscrepancyError(f"--trials {text!r}: expected a comma list of trial ids") from None
+
+
+def split_trials(info: pd.DataFrame, rng: np.random.Generator) -> tuple[list[int], list[int]]:
+    """Split trials in two halves, stratified by (gait, frequency); by trial, never sample.
+
+    Within a condition the trials are shuffled and dealt alternately, the first to the
+    training half; conditions are visited in a shuffled order so odd counts balance.
+    """
+    per = info.drop_duplicates("trial_id")
+    train, test = [], []
+    groups = list(per.groupby(["gait", "frequency_hz"], sort=True))
+    for i in rng.permutation(len(groups)):
+        ids = rng.permutation(groups[i][1]["trial_id"].to_numpy())
+        first, second = (train, test) if len(train) <= len(test) else (test, train)
+        first.extend(int(x) for x in ids[0::2])
+        second.extend(int(x) for x in ids[1::2])
+    return sorted(train), sorted(test)
+
+
+def _observable(cand: Candidate, model: SimConfig, probe: WindowSet) -> bool:
+    """Does the candidate change the replayed body velocity at all (one window)?"""
+    if cand.param is None:
+        configs = [model, cand.apply(model, None)]
+    else:
+        configs = [model, cand.apply(model, cand.bounds[0]), cand.apply(model, cand.bounds[1])]
+    v = replay(probe, configs)
+    ref = np.nan_to_num(v[0])
+    return any(np.nanmax(np.abs(np.nan_to_num(x) - ref)) > 1e-9 for x in v[1:])
+
+
+def _resolve_prep(store, prep: str | int | None) -> tuple[str, dict]:
+    from suds_exp.preprocess import list_versions
+
+    versions = list_versions(store)
+    if versions.empty:
+        raise DiscrepancyError("--prep: no preprocessing version; run `suds-exp preprocess` first")
+    if prep is None:
+        if len(versions) != 1:
+            raise DiscrepancyError(
+                "--prep: name the preprocessing version to replay (have: "
+                + ", ".join(versions["name"].astype(str))
+                + ")"
+            )
+        row = versions.iloc[0]
+    else:
+        hit = versions[
+            (versions["name"].astype(str) == str(prep)) | (versions["id"].astype(str) == str(prep))
+        ]
+        if hit.empty:
+            raise DiscrepancyError(
+                f"--prep {prep}: no such preprocessing version (have: "
+                + ", ".join(versions["name"].astype(str))
+                + ")"
+            )
+        row = hit.iloc[0]
+    params = row["params"]
+    return str(row["name"]), json.loads(params) if isinstance(params, str) else dict(params)
+
+
+def _full_rate(rs: ReplaySettings) -> ReplaySettings:
+    """Settings of the undecimated replay: every captured frame, a longer warm-up."""
+    return dataclasses.replace(
+        rs, samples_per_cycle=10**6, warmup_cycles=max(1.5, rs.warmup_cycles)
+    )
+
+
+def _rmse(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.nanmean((sim - meas) ** 2, axis=(0, 1)))
+
+
+def run_discrepancy(
+    store=None,
+    prep: str | int | None = None,
+    model: SimConfig | None = None,
+    name: str | None = None,
+    trials: Iterable[int] | None = None,
+    options: DiscrepancyOptions | None = None,
+    out: str | Path | None = None,
+    samples: pd.DataFrame | None = None,
+    log: Callable[[str], None] | None = None,
+    default_out: Path | None = None,
+) -> DiscrepancyResult:
+    """Find, name and fix what ``model`` misses about the measured trials.
+
+    Parameters
+    ----------
+    store : Store, optional
+        Source of the samples (``load_samples(store, prep)``) and where the run is
+        recorded (tables discrepancy_*); None with ``samples`` given: nothing stored.
+    prep : str or int, optional
+        Preprocessing version (name or id); None: the only one.
+    model : SimConfig, optional
+        Starting model (default: the nominal simulator).
+    name : str, optional
+        Run name (default ``discrepancy-<timestamp>``).
+    trials : iterable of int, optional
+        Only these trial ids.
+    options : DiscrepancyOptions, optional
+    out : path, optional
+        Report folder (index.html, PNG figures, Markdown/CSV tables); None: no report,
+        unless ``default_out`` is given (then ``default_out / name``).
+    samples : DataFrame, optional
+        A samples frame to use instead of loading one from the store.
+    log : callable, optional
+        Receives one line per stage (progress).
+
+    Returns
+    -------
+    DiscrepancyResult
+    """
+    started = time.perf_counter()
+    started_at = _dt.datetime.now()
+    opts = options or DiscrepancyOptions()
+    if not 0 < opts.alpha < 1:
+        raise DiscrepancyError(f"--alpha {opts.alpha}: must be between 0 and 1")
+    if opts.max_effects < 0:
+        raise DiscrepancyError(f"--max-effects {opts.max_effects}: must be >= 0")
+    say = log or (lambda _msg: None)
+    prep_name, prep_params = None, {}
+    if samples is None:
+        if store is None:
+            raise DiscrepancyError("run_discrepancy: give a store or a samples frame")
+        from suds_exp.preprocess import load_samples
+
+        prep_name, prep_params = _resolve_prep(store, prep)
+        samples = load_samples(store, prep_name, trials)
+    elif trials is not None:
+        samples = samples[samples["trial_id"].isin(list(trials))]
+    if samples.empty:
+        raise DiscrepancyError("no samples to replay: check --trials and --prep")
+    rs = opts.replay or settings_from_prep(prep_params)
+    model = model or SimConfig()
+    name = name or f"discrepancy-{started_at:%Y%m%d-%H%M%S}"
+    if out is None and default_out is not None:
+        out = Path(default_out) / (
+            name if name.startswith("discrepancy") else f"discrepancy-{name}"
+        )
+    rng = np.random.default_rng(opts.seed)
+
+    windows = make_windows(samples, rs)
+    if len(windows.info) == 0:
+        raise DiscrepancyError(
+            "every trial is shorter than one replay window "
+            f"({rs.warmup_cycles + rs.cycles_per_window} cycles)"
+        )
+    train_ids, test_ids = split_trials(windows.info, rng)
+    if len(train_ids) < 2 or len(test_ids) < 2:
+        raise DiscrepancyError(
+            f"need at least 4 trials long enough to replay, have {len(train_ids) + len(test_ids)}"
+        )
+    train, test = windows.subset(train_ids), windows.subset(test_ids)
+    coarse_meas = measured(windows)
+    scales = np.sqrt(np.nanmean(coarse_meas**2, axis=(0, 1)))
+    # the gap itself (and the parameter refinement) is measured without decimation: the
+    # decimated replay's own error would otherwise look like a systematic gap
+    full = make_windows(samples[samples["trial_id"].isin(windows.trial_id)], _full_rate(rs))
+    meas_all = measured(full)
+    is_test = np.isin(full.trial_id, test_ids)
+    phase_all, ra_all, t_all = (window_field(full, f) for f in ("phase", "ra", "t"))
+    say(
+        f"{len(windows.info)} windows over {len(train_ids)} training and "
+        f"{len(test_ids)} held-out trials"
+    )
+
+    steps: list[Step] = []
+    accepted_effects: set[str] = set()
+    current = model
+    example_k = int(np.flatnonzero(is_test)[0])
+    for index in range(opts.max_effects + 1):
+        sim = replay(full, [current])[0]
+        residual = sim - meas_all
+        _, tl = trial_losses(sim[None, is_test], meas_all[is_test], scales, full.trial_id[is_test])
+        step = Step(
+            index=index,
+            model=current,
+            test_loss=float(tl[0].mean()),
+            test_rmse=_rmse(sim[is_test], meas_all[is_test]),
+            test_trial_loss=tl[0],
+            localisation=localise(full.info, residual, phase_all, ra_all, rng),
+            example={
+                "trial_id": int(full.trial_id[example_k]),
+                "t": t_all[example_k],
+                "measured": meas_all[example_k],
+                "simulated": sim[example_k],
+            },
+        )
+        if steps:
+            prev = steps[-1]
+            prev.gap_closed = 1.0 - step.test_loss / prev.test_loss if prev.test_loss > 0 else 0.0
+        steps.append(step)
+        say(
+            f"step {index}: held-out loss {step.test_loss:.4g}, "
+            f"rmse vx {step.test_rmse[0]:.3g} mm/s"
+        )
+        if len(accepted_effects) >= opts.max_effects:
+            step.decision = "max_effects"
+            break
+        offered = candidates_for(current, exclude=accepted_effects)
+        probe = train.subset(train_ids[:1])
+        cands = []
+        for c in offered:
+            if _observable(c, current, probe):
+                cands.append(c)
+            else:
+                step.unobservable.append(c.label)
+        for c in cands:
+            r = fit_candidate(c, current, train, scales, opts.fit, rng)
+            step.candidates.append(r)
+            say(f"  fitted {c.label}: {r.value} in {r.seconds:.1f} s")
+        if step.candidates:
+            score_candidates(step.candidates, current, test, scales, opts.alpha, opts.fit)
+        significant = [r for r in step.candidates if r.significant]
+        if not significant:
+            step.decision = "none_significant"
+            # systematic = the residual's phase profile repeats across independent halves
+            step.systematic = systematic_gap(residual, phase_all, full.info, (train_ids, test_ids))
+            if step.systematic[1] < opts.alpha and step.test_loss > opts.gap_floor:
+                step.correlations = residual_correlations(
+                    samples,
+                    residual[is_test],
+                    t_all[is_test],
+                    full.info[is_test].reset_index(drop=True),
+                )
+            break
+        best = max(significant, key=lambda r: r.improvement)
+        if opts.refine and best.candidate.param is not None:
+            refine_candidate(best, current, full.subset(train_ids), scales, opts.fit, rng)
+            say(f"  refined {best.candidate.label} at the capture rate: {best.value:.4g} {best.ci}")
+        best.accepted = True
+        step.accepted = best
+        step.decision = "accepted"
+        accepted_effects.add(best.candidate.effect)
+        current = best.config
+        say(
+            f"  named {best.candidate.label} (p_adj {best.p_adjusted:.2g}, "
+            f"held-out improvement {best.improvement:.0%})"
+        )
+
+    last = steps[-1]
+    named = [s.accepted.candidate.label for s in steps if s.accepted]
+    if last.correlations is not None:
+        top = last.correlations.head(3)
+        outcome = (
+            "a systematic gap remains that no candidate explains; residual correlates most with "
+            + ", ".join(f"{r.signal} ({r.channel}, r={r.r:+.2f})" for r in top.itertuples())
+        )
+    elif named:
+        outcome = "named " + ", ".join(named)
+    else:
+        outcome = "nothing named: no candidate improves the held-out fit significantly"
+    result = DiscrepancyResult(
+        run_id=None,
+        name=name,
+        prep_version=prep_name,
+        steps=steps,
+        train_trials=train_ids,
+        test_trials=test_ids,
+        start_model=model,
+        final_model=current,
+        outcome=outcome,
+        seconds=time.perf_counter() - started,
+    )
+    if out is not None:
+        from suds_exp.discrepancy.report import write_report
+
+        result.report_dir = write_report(result, Path(out))
+    if store is not None:
+        from suds_exp.discrepancy.record import record_run
+
+        result.run_id = record_run(store, result, opts, started_at)
+    return result

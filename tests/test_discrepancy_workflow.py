@@ -1,0 +1,180 @@
+"""The discrepancy workflow through its public faces: CLI, library, SQL tables, report.
+
+Measured data always takes the real path (simulate -> QTM files -> ingest -> preprocess).
+The fast tests share one small dataset with a hidden effect; the sweeps over every
+effect, seeds, two effects and the null control are `slow`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cli import app
+from suds_exp.discrepancy import candidates_for, draw_hidden, hidden_effect_run
+from suds_exp.discrepancy.demo import HIDDEN, simulate_measured
+from suds_exp.sim.config import SimConfig
+from suds_exp.store import Store
+
+runner = CliRunner()
+TAU = 0.2
+SMALL = dict(gaits=("S+", "D+"), frequencies_hz=(0.5, 1.0), repeats=3, cycles=(3, 4))
+
+
+@pytest.fixture(scope="module")
+def inertia_db(tmp_path_factory) -> Path:
+    """A store holding a small dataset simulated with body inertia the nominal model lacks."""
+    work = tmp_path_factory.mktemp("hidden")
+    truth = SimConfig()
+    truth.effects.body_inertia.tau_s = TAU
+    simulate_measured(work, truth, seed=3, **SMALL)
+    return work / "suds.duckdb"
+
+
+@pytest.fixture(scope="module")
+def cli_run(inertia_db, tmp_path_factory):
+    out = tmp_path_factory.mktemp("report") / "disc"
+    res = runner.invoke(
+        app,
+        [
+            "discrepancy",
+            "--db",
+            str(inertia_db),
+            "--out",
+            str(out),
+            "--max-effects",
+            "2",
+            "--name",
+            "hidden-inertia",
+            "--json",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    return json.loads(res.stdout), out
+
+
+def test_names_the_hidden_effect_with_an_interval_covering_the_truth(cli_run):
+    doc, _ = cli_run
+    assert doc["named"], doc["outcome"]
+    first = doc["named"][0]
+    assert first["effect"] == "body_inertia"
+    lo, hi = first["ci"]
+    assert lo <= TAU <= hi
+    assert doc["gap_after"] <= 0.5 * doc["gap_before"]
+    # nothing else is named once the effect is in the model
+    assert [n["effect"] for n in doc["named"]] == ["body_inertia"]
+
+
+def test_run_is_stored_in_the_discrepancy_tables(cli_run, inertia_db):
+    doc, _ = cli_run
+    store = Store(inertia_db)
+    run = store.query_df("SELECT * FROM discrepancy_runs WHERE id = ?", [doc["run_id"]])
+    assert run.loc[0, "name"] == "hidden-inertia"
+    assert json.loads(run.loc[0, "named_effects"]) == ["body_inertia"]
+    train, test = json.loads(run.loc[0, "train_trials"]), json.loads(run.loc[0, "test_trials"])
+    assert train and test and not set(train) & set(test)
+    steps = store.query_df(
+        "SELECT step, decision, accepted, value, ci_low, ci_high FROM discrepancy_steps "
+        "WHERE run_id = ? ORDER BY step",
+        [doc["run_id"]],
+    )
+    assert steps.decision.tolist()[0] == "accepted"
+    assert steps.decision.tolist()[-1] in ("none_significant", "max_effects")
+    cands = store.query_df(
+        "SELECT candidate, accepted, significant FROM discrepancy_candidates "
+        "WHERE run_id = ? AND step = 0",
+        [doc["run_id"]],
+    )
+    assert cands[cands.accepted].candidate.tolist() == ["body_inertia"]
+    views = store.query_df(
+        "SELECT DISTINCT view FROM discrepancy_localisation WHERE run_id = ?", [doc["run_id"]]
+    )
+    assert set(views.view) == {"condition", "phase", "shape", "time"}
+
+
+def test_report_page_is_self_contained(cli_run):
+    _, out = cli_run
+    page = (out / "index.html").read_text()
+    for name in ("condition.png", "phase.png", "time.png", "shape.png", "example.png"):
+        assert (out / name).stat().st_size > 1000
+        assert name in page
+    assert "http://" not in page and "https://" not in page
+    assert (out / "steps.csv").exists() and (out / "candidates.md").exists()
+
+
+def test_user_errors_exit_2(inertia_db):
+    for args in (
+        ["--alpha", "2"],
+        ["--prep", "nope"],
+        ["--trials", "a,b"],
+        ["--model-effect", "warp_drive=3"],
+    ):
+        res = runner.invoke(app, ["discrepancy", "--db", str(inertia_db), *args])
+        assert res.exit_code == 2, (args, res.output)
+
+
+def test_candidates_are_the_effects_the_model_lacks():
+    labels = {c.label for c in candidates_for(SimConfig())}
+    assert {
+        "hinge_damping",
+        "body_inertia",
+        "asymmetric_drag",
+        "drag_anisotropy",
+        "medium_compaction",
+        "flippers=locked",
+        "flippers=absent",
+    } <= labels
+    # spoke oscillation is on in the nominal robot: not a missing effect
+    assert "spoke_oscillation" not in labels
+    cfg = SimConfig()
+    cfg.effects.flippers.mode = "absent"
+    cfg.effects.hinge_damping.damping = 10.0
+    labels = {c.label for c in candidates_for(cfg)}
+    assert "flippers=free" in labels and "hinge_damping" not in labels
+
+
+def test_hidden_values_are_drawn_inside_the_realistic_range():
+    rng = np.random.default_rng(1)
+    for effect, (_, param) in HIDDEN.items():
+        for _ in range(20):
+            v = draw_hidden(effect, rng)[param]
+            cand = next(c for c in candidates_for(SimConfig()) if c.effect == effect and c.param)
+            assert cand.bounds[0] <= v <= cand.bounds[1]
+
+
+# -- slow sweeps ------------------------------------------------------------------------
+
+SWEEP = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("effect", sorted(HIDDEN))
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_each_hidden_effect_is_named_first(effect, seed, tmp_path):
+    rng = np.random.default_rng(seed)
+    settings = draw_hidden(effect, rng)
+    run = hidden_effect_run({effect: settings}, seed=seed, workdir=tmp_path, **SWEEP)
+    named = run.result.named
+    assert named and named[0]["effect"] == effect, run.result.outcome
+    lo, hi = named[0]["ci"]
+    truth = run.truth(effect)
+    assert lo <= truth <= hi, (truth, named[0])
+    assert run.result.gap_after <= 0.5 * run.result.gap_before
+
+
+@pytest.mark.slow
+def test_two_hidden_effects_are_both_named(tmp_path):
+    hidden = {"body_inertia": {"tau_s": 0.2}, "drag_anisotropy": {"normal_scale": 1.6}}
+    run = hidden_effect_run(hidden, seed=21, workdir=tmp_path, **SWEEP)
+    assert set(run.named_effects[:2]) == set(hidden), run.result.outcome
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [31, 32, 33])
+def test_null_control_names_nothing(seed, tmp_path):
+    run = hidden_effect_run({}, seed=seed, workdir=tmp_path, **SWEEP)
+    assert run.named_effects == [], run.result.named
