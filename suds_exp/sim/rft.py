@@ -453,48 +453,37 @@ def _solve_step(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge, work
     if nr <= tol:
         return nr, total, True
     # continuation on the smoothing scale: solve a smoother problem first, from the
-    # warm start and, if that fails too, from rest
-    for attempt in range(2):
+    # warm start, then from rest, then from rest in finer steps; keep the best solution
+    best = nr
+    xbest = x.copy()
+    for attempt in range(3):
         for i in range(N_UNKNOWN):
             x[i] = x0[i] if attempt == 0 else 0.0
+        factor = 3.1622776601683795 if attempt < 2 else 1.5
         mult = 1000.0
         while mult > 0.9:
             nr, it = _newton(
-                x,
-                geo,
-                el_w,
-                el_part,
-                prm,
-                eps * mult,
-                normal_fac,
-                held,
-                ang,
-                c_hinge,
-                tol,
-                max_iter,
-                work,
-            )
+                x, geo, el_w, el_part, prm, eps * mult, normal_fac, held, ang, c_hinge,
+                tol, max_iter, work,
+            )  # fmt: skip
             total += it
             if nr > tol:
                 nr, it = _lm(
-                    x,
-                    geo,
-                    el_w,
-                    el_part,
-                    prm,
-                    eps * mult,
-                    normal_fac,
-                    held,
-                    ang,
-                    c_hinge,
-                    tol,
-                    4 * max_iter,
-                    work,
-                )
+                    x, geo, el_w, el_part, prm, eps * mult, normal_fac, held, ang, c_hinge,
+                    tol, 4 * max_iter, work,
+                )  # fmt: skip
                 total += it
-            mult /= 3.1622776601683795
+            mult /= factor
+        if nr < best:
+            best = nr
+            for i in range(N_UNKNOWN):
+                xbest[i] = x[i]
         if nr <= tol:
             break
+    if best < nr:
+        for i in range(N_UNKNOWN):
+            x[i] = xbest[i]
+        nr = best
     return nr, total, True
 
 
