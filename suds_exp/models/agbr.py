@@ -466,26 +466,35 @@ class GMRSuds(GMR):
         hi = (self.rp_bounds_[1] - self.center_[2 : 2 + k]) / self.scale_[2 : 2 + k]
         c = self._cond
         P, mu_in, reg, mu_out = c.prec_in, c.mean_in, c.reg, c.mean_out
+        K, q = mu_out.shape
+        n = len(Xs)
+        # Only r_p (inputs 2..2+k) changes along the rollout, so everything else of the
+        # whitened inputs and of the local means is computed for all samples at once;
+        # a step is then two small matrix products: yk = Y0_t + r_p W, m = M0_t + r_p R.
+        rp_idx = np.arange(2, 2 + k)
+        known = Xs.copy()
+        known[:, rp_idx] = 0.0
+        Y0 = np.einsum("nd,kde->nke", known, P) - np.einsum("kd,kde->ke", mu_in, P)[None]
+        W = P[:, rp_idx, :].transpose(1, 0, 2).reshape(k, -1)  # (k, K * d)
+        M0 = (
+            mu_out[None]
+            + np.einsum("kqd,nd->nkq", reg, known)
+            - np.einsum("kqd,kd->kq", reg, mu_in)[None]
+        )
+        R = reg[:, :, rp_idx].transpose(2, 0, 1).reshape(k, -1)  # (k, K * q)
         filt = self.branching == "filter"
         T, pri = self.transition_, self.priors_
         first = ts.first
-        out = np.empty((len(Xs), mu_out.shape[1]))
-        rp = np.empty((len(Xs), k))
+        out = np.empty((n, q))
+        rp = np.empty((n, k))
         a = pri
-        x = Xs[0].copy()
-        for t in range(len(Xs)):
+        x = Xs[0, rp_idx].copy()
+        for t in range(n):
             if first[t]:
-                x = Xs[t].copy()
+                x = Xs[t, rp_idx].copy()
             else:
-                x[:2] = Xs[t, :2]
-                x[2 + k :] = Xs[t, 2 + k :]
-                x[2 : 2 + k] = np.clip(
-                    x[2 : 2 + k] + ts.dt[t] * fs[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off),
-                    lo,
-                    hi,
-                )
-            diff = x - mu_in
-            yk = np.einsum("kd,kde->ke", diff, P)
+                x = np.clip(x + ts.dt[t] * fs[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off), lo, hi)
+            yk = Y0[t] + (x @ W).reshape(K, -1)
             lg = c.log_norm - 0.5 * (yk * yk).sum(1)
             e = np.exp(lg - lg.max())
             if filt:
@@ -495,8 +504,7 @@ class GMRSuds(GMR):
                 a = e
             s = a.sum()
             a = a / s if s > 0 else pri
-            ys = a @ (mu_out + np.einsum("kqd,kd->kq", reg, diff))
-            out[t] = ys
-            rp[t] = x[2 : 2 + k]
+            out[t] = a @ (M0[t] + (x @ R).reshape(K, q))
+            rp[t] = x
         rp = rp * self.scale_[2 : 2 + k] + self.center_[2 : 2 + k]
         return ts.unsort(out * self.scale_[d:] + self.center_[d:]) * f[:, None], ts.unsort(rp)
