@@ -253,10 +253,10 @@ class SpokeOscillationEffect:
         ),
     )
     freq_hz: float = field(
-        default=4.0, metadata=_p("Hz", 2.0, 10.0, "natural frequency of the spoke")
+        default=5.0, metadata=_p("Hz", 2.0, 10.0, "natural frequency of the spoke")
     )
     damping_ratio: float = field(
-        default=0.08, metadata=_p("-", 0.02, 0.4, "damping ratio of the spoke")
+        default=0.15, metadata=_p("-", 0.02, 0.4, "damping ratio of the spoke")
     )
 
 
