@@ -27,7 +27,9 @@ app = typer.Typer(
 
 DbOption = Annotated[
     Path | None,
-    typer.Option("--db", envvar="SUDS_DB", help="DuckDB file [default: ./suds.duckdb]."),
+    typer.Option(
+        "--db", envvar="SUDS_DB", help="DuckDB file (default: ./suds.duckdb, or $SUDS_DB)."
+    ),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]

@@ -6,6 +6,7 @@ import json
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -131,6 +132,21 @@ def test_file_opens_read_only_in_a_separate_duckdb_process(db, make_qtm):
     )
     assert done.returncode == 0, done.stderr
     assert int(done.stdout) == 150
+
+
+def test_stock_duckdb_cli_opens_the_file_read_only(db, make_qtm):
+    cli_path = shutil.which("duckdb") or str(Path(sys.executable).parent / "duckdb")
+    if not Path(cli_path).exists():
+        pytest.skip("the duckdb CLI (pip package duckdb-cli) is not installed")
+    assert runner.invoke(app, ["ingest", str(make_qtm("a.tsv")), "--db", str(db)]).exit_code == 0
+    done = subprocess.run(
+        [cli_path, "-readonly", "-csv", str(db), "-c", "SELECT count(*) AS n FROM markers"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["n", "150"]
 
 
 def test_trials_command_shows_conditions(db, make_qtm, tmp_path):

@@ -21,6 +21,10 @@ from sqlalchemy.pool import NullPool
 from suds_exp.errors import StoreError
 
 DEFAULT_DB = "suds.duckdb"
+#: On-disk format of new files: the newest one the released DuckDB CLI (`duckdb-cli`
+#: 1.5) can read, so a stock `duckdb -readonly suds.duckdb` session opens our files.
+#: A file keeps the format it was created with.
+STORAGE_VERSION = "v1.4.0"
 #: How long a process waits for another one to release the file, in seconds.
 LOCK_WAIT_S = 15.0
 
@@ -34,11 +38,10 @@ def default_db_path() -> Path:
 
 def make_engine(path: Path, read_only: bool = False) -> sa.Engine:
     """A SQLAlchemy engine on the DuckDB file ``path`` that never pools connections."""
-    return sa.create_engine(
-        f"duckdb:///{path}",
-        poolclass=NullPool,
-        connect_args={"read_only": read_only},
-    )
+    connect_args: dict = {"read_only": read_only}
+    if not read_only:
+        connect_args["config"] = {"storage_compatibility_version": STORAGE_VERSION}
+    return sa.create_engine(f"duckdb:///{path}", poolclass=NullPool, connect_args=connect_args)
 
 
 def is_lock_error(exc: BaseException) -> bool:
