@@ -117,3 +117,12 @@ def test_a_robot_standing_still_predicts_no_motion():
         pred = make_model(name).fit(still).predict(still)
         assert np.isfinite(pred.to_numpy()).all()
         assert np.abs(pred[rest].to_numpy()).max() < 1e-9
+
+
+def test_bic_chooses_among_the_candidates():
+    train = make_samples(10, passive="travel", velocity="finsler", seed=4)
+    m = make_model("GMR", select_k="bic", k_candidates=(1, 8)).fit(train)
+    assert m.n_components_ == 8  # one Gaussian cannot follow a gait loop
+    assert len(m.priors_) == 8 and np.isfinite(m.bic_)
+    fixed = make_model("GMR", n_components=8).fit(train)
+    np.testing.assert_allclose(m.predict(train), fixed.predict(train))

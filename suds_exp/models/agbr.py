@@ -293,7 +293,9 @@ class GMR(Learner):
         ks = [self.n_components] if self.select_k == "none" else list(self.k_candidates)
         best, best_bic = None, np.inf
         for k in ks:
-            mix = fit_mixture(X, k, w, self.max_iter, self.tol, self.reg_covar, rng)
+            # each K has its own stream, so the K that BIC picks is the fixed-K model
+            em_rng = np.random.default_rng([self.random_state, k])
+            mix = fit_mixture(X, k, w, self.max_iter, self.tol, self.reg_covar, em_rng)
             bic = -2 * mix.log_likelihood * w.sum() + mix.n_parameters() * np.log(w.sum())
             if bic < best_bic:
                 best, best_bic = mix, bic
