@@ -179,8 +179,8 @@ class GMR(Learner):
     units over the inputs `columns_in_` (then hist_1, hist_2 with branching="history")
     and the outputs `columns_out_`, rates divided by rho^alpha; `center_`, `scale_` (D,)
     the standardisation; `speed_floor_` (rad/s); `transition_` (K, K) the branch
-    transition matrix; `rp_bounds_` (2, k) rollout limits (SUDS); `n_iter_`,
-    `converged_`, `n_components_` (K actually used), `bic_`.
+    transition matrix (None unless branching="filter"); `rp_bounds_` (2, k) rollout
+    limits (SUDS); `n_iter_`, `converged_`, `n_components_` (K actually used), `bic_`.
     """
 
     name = "GMR"
@@ -307,15 +307,17 @@ class GMR(Learner):
         self._cond = Conditional.of(
             self.priors_, self.means_, self.covariances_, np.arange(d), np.arange(d, len(rate))
         )
-        # Branch transitions from consecutive original samples of the same trial.
-        K = self.n_components_
-        ts = TimeSeries.of(samples)
-        g = responsibilities(X[: len(Z)][ts.order], best)
-        pairs = ~ts.first[1:]
-        counts = g[:-1][pairs].T @ g[1:][pairs] if pairs.any() else np.zeros((K, K))
-        rows = counts.sum(axis=1, keepdims=True)
-        T = np.where(rows > 0, counts / np.where(rows > 0, rows, 1.0), self.priors_[None])
-        self.transition_ = (1 - self.branch_mix) * T + self.branch_mix * self.priors_[None]
+        self.transition_ = None
+        if self.branching == "filter":
+            # Branch transitions from consecutive original samples of the same trial.
+            K = self.n_components_
+            ts = TimeSeries.of(samples)
+            g = responsibilities(X[: len(Z)][ts.order], best)
+            pairs = ~ts.first[1:]
+            counts = g[:-1][pairs].T @ g[1:][pairs] if pairs.any() else np.zeros((K, K))
+            rows = counts.sum(axis=1, keepdims=True)
+            T = np.where(rows > 0, counts / np.where(rows > 0, rows, 1.0), self.priors_[None])
+            self.transition_ = (1 - self.branch_mix) * T + self.branch_mix * self.priors_[None]
         self.n_features_in_ = d
         if rp_cols:
             self.rp_bounds_ = rollout_bounds(as_array(samples, rp_cols, self.name))
