@@ -19,6 +19,7 @@ from suds_exp.sim import (
     load_config,
     local_connection,
 )
+from suds_exp.sim.connection import HATTON_CALIBRATED_MEDIUM
 
 runner = CliRunner()
 SHARED = Path(__file__).resolve().parents[2] / "shared"
@@ -106,3 +107,6 @@ def test_classic_connection_against_hatton_2013():
     best = compare_with_hatton(HATTON, method="lstsq", relabel=True)
     assert best["mean"] < 0.3
     assert all(v < 0.45 for v in best.values())
+    # with medium coefficients calibrated to the table: near its own asymmetry (~0.10)
+    calibrated = compare_with_hatton(HATTON, relabel=True, medium=HATTON_CALIBRATED_MEDIUM)
+    assert calibrated["mean"] < 0.2

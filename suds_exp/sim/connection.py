@@ -37,11 +37,20 @@ CONNECTION_COLUMNS = (
 # GeometricSystemPlotter's grid (-10:10) * pi / 11 is labelled -2.5:0.25:2.5 in the
 # published granular table; true angle = label * this (likely, see the notes).
 HATTON_RELABEL = (10 * np.pi / 11) / 2.5
+# Medium coefficients calibrated to the published granular table (C_S kept at 3.21; only
+# ratios matter): Nelder-Mead on the mean normalised RMS difference of the six
+# components, least-squares connection, relabelled grid (benchmarks in the README).
+# A fit to the table, not a measured medium: use it to compare fields, not as beans.
+HATTON_CALIBRATED_MEDIUM = {"c_f": 1.569, "c_l": -0.93, "gamma": 1.739}
 
 
-def classic_config(elements_per_link: int = 20) -> SimConfig:
-    """The textbook three-link swimmer: equal links of total length 1 (unit: total length)."""
+def classic_config(elements_per_link: int = 20, medium: dict | None = None) -> SimConfig:
+    """The textbook three-link swimmer: equal links of total length 1 (unit: total length).
+
+    medium: optional overrides of `Medium` fields, e.g. HATTON_CALIBRATED_MEDIUM."""
     cfg = SimConfig()
+    for key, value in (medium or {}).items():
+        setattr(cfg.medium, key, value)
     g = cfg.geometry
     g.middle_length_mm = g.head_length_mm = g.tail_length_mm = 1 / 3
     g.elements_per_segment = elements_per_link
@@ -107,17 +116,20 @@ def local_connection(
     n_directions: int = 8,
     method: str = "lstsq",
     phi_values: np.ndarray | None = None,
+    medium: dict | None = None,
 ) -> Connection:
     """Local connection on a grid x grid square of (phi1, phi2) in [-half_range, half_range].
 
     geometry: "robot" (config, flippers locked) or "classic"; method: "lstsq" (fit over
     n_directions shape-rate directions) or "columns"; phi_values overrides the grid axis
-    (rad), e.g. to evaluate at relabelled angles.
+    (rad), e.g. to evaluate at relabelled angles; medium overrides `Medium` fields.
     """
     try:
         cfg = GEOMETRIES[geometry](config)
     except KeyError:
         raise ConfigError(f"--geometry {geometry!r}: expected robot or classic") from None
+    for key, value in (medium or {}).items():
+        setattr(cfg.medium, key, value)
     if grid < 2:
         raise ConfigError(f"--grid {grid}: need at least 2 points per axis")
     axis = np.linspace(-half_range, half_range, grid) if phi_values is None else phi_values
@@ -182,13 +194,15 @@ def compare_with_hatton(
     relabel: bool = False,
     method: str = "lstsq",
     n_directions: int = 8,
+    medium: dict | None = None,
 ) -> dict[str, float]:
     """RMS(ours - published) / RMS(published) per component of the classic swimmer.
 
     The published table (Hatton et al. 2013, granular) is read raw as xi = +T alpha_dot,
     alpha1 = our phi2 (tail joint, link 1 at -x), alpha2 = our phi1; its translational
     rows are per unit link length, so ours (total length 1) are multiplied by 3.
-    relabel=True evaluates ours at the probable true angles (labels x HATTON_RELABEL).
+    relabel=True evaluates ours at the probable true angles (labels x HATTON_RELABEL);
+    medium overrides the medium coefficients (e.g. HATTON_CALIBRATED_MEDIUM).
     Returns {"Ax1": ..., ..., "Atheta2": ..., "mean": ...}.
     """
     from scipy.io import loadmat
@@ -197,7 +211,11 @@ def compare_with_hatton(
     labels = np.asarray(mat["alpha1"])[:, 0]
     axis = labels * (HATTON_RELABEL if relabel else 1.0)
     conn = local_connection(
-        geometry="classic", phi_values=axis, method=method, n_directions=n_directions
+        geometry="classic",
+        phi_values=axis,
+        method=method,
+        n_directions=n_directions,
+        medium=medium,
     )
     A = conn.A  # [i (phi1), j (phi2), comp, k]
     # table index [a, b] is at (alpha1 = labels[a], alpha2 = labels[b]) = (phi2, phi1)
