@@ -111,6 +111,7 @@ class DiscrepancyResult:
     final_model: SimConfig
     outcome: str
     seconds: float
+    cpu_seconds: float = 0.0
     report_dir: Path | None = None
 
     @property
@@ -187,6 +188,7 @@ class DiscrepancyResult:
             ],
             "outcome": self.outcome,
             "seconds": self.seconds,
+            "cpu_seconds": self.cpu_seconds,
             "report_dir": str(self.report_dir) if self.report_dir else None,
             "train_trials": self.train_trials,
             "test_trials": self.test_trials,
@@ -312,6 +314,7 @@ def run_discrepancy(
     DiscrepancyResult
     """
     started = time.perf_counter()
+    cpu_started = time.process_time()
     started_at = _dt.datetime.now()
     opts = options or DiscrepancyOptions()
     if not 0 < opts.alpha < 1:
@@ -462,6 +465,7 @@ def run_discrepancy(
         final_model=current,
         outcome=outcome,
         seconds=time.perf_counter() - started,
+        cpu_seconds=time.process_time() - cpu_started,
     )
     if out is not None:
         from suds_exp.discrepancy.report import write_report

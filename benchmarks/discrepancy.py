@@ -1,0 +1,125 @@
+"""Benchmark of the discrepancy workflow: confusion matrix over hidden effects x seeds,
+null control, and the workflow's time on the default dataset.
+
+Every run simulates "measured" data with one effect hidden (its parameter drawn from the
+realistic range with the run's seed), sends it through files -> ingest -> preprocess and
+runs the workflow from the nominal model. A hit: the hidden effect is named first, its
+interval covers the true value and the held-out gap at least halves.
+
+    .venv/bin/python benchmarks/discrepancy.py --seeds 3 --null-seeds 4 --out bench-disc.csv
+    .venv/bin/python benchmarks/discrepancy.py --timing-only     # default dataset timing
+
+Rows are appended to --out as runs finish, so an interrupted benchmark keeps its results
+(and a re-run skips the rows already there).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.discrepancy import draw_hidden, hidden_effect_run
+from suds_exp.discrepancy.demo import HIDDEN
+
+DESIGN = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
+
+
+def one_run(effect: str | None, seed: int) -> dict:
+    rng = np.random.default_rng(seed)
+    hidden = {} if effect is None else {effect: draw_hidden(effect, rng)}
+    started = time.perf_counter()
+    run = hidden_effect_run(hidden, seed=seed, **DESIGN)
+    res = run.result
+    named = res.named
+    first = named[0] if named else None
+    truth = run.truth(effect) if effect else None
+    covers = (
+        bool(first and first["ci"] and first["ci"][0] <= truth <= first["ci"][1])
+        if (effect and first and first["effect"] == effect)
+        else False
+    )
+    halved = res.gap_after <= 0.5 * res.gap_before
+    return {
+        "hidden": effect or "none",
+        "seed": seed,
+        "truth": truth,
+        "first_named": first["effect"] if first else "nothing",
+        "all_named": ";".join(n["candidate"] for n in named),
+        "value": first["value"] if first else None,
+        "ci_low": first["ci"][0] if first and first["ci"] else None,
+        "ci_high": first["ci"][1] if first and first["ci"] else None,
+        "covers": covers,
+        "gap_before": res.gap_before,
+        "gap_after": res.gap_after,
+        "halved": halved,
+        "hit": (first is not None and first["effect"] == effect and covers and halved)
+        if effect
+        else not named,
+        "workflow_seconds": res.seconds,
+        "total_seconds": time.perf_counter() - started,
+    }
+
+
+def default_timing(seed: int = 0) -> dict:
+    """The workflow on the default dataset (5 gaits x 3 frequencies x 4 repeats, 10-30
+    cycles) with body inertia hidden."""
+    rng = np.random.default_rng(seed)
+    hidden = {"body_inertia": draw_hidden("body_inertia", rng)}
+    cpu = time.process_time()
+    run = hidden_effect_run(
+        hidden, seed=seed, gaits=("S+", "S-", "O", "D-", "D+"), repeats=4, cycles=(10, 30)
+    )
+    return {
+        "hidden": hidden,
+        "named": [n["candidate"] for n in run.result.named],
+        "workflow_seconds": run.result.seconds,
+        "cpu_seconds_incl_simulation_and_preprocessing": time.process_time() - cpu,
+        "n_trials": len(run.result.train_trials) + len(run.result.test_trials),
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=3, help="seeds per hidden effect")
+    ap.add_argument("--null-seeds", type=int, default=4, help="seeds of the null control")
+    ap.add_argument("--effects", default=",".join(sorted(HIDDEN)))
+    ap.add_argument("--out", type=Path, default=Path("bench-discrepancy.csv"))
+    ap.add_argument("--timing-only", action="store_true")
+    ap.add_argument("--no-timing", action="store_true")
+    args = ap.parse_args()
+    if not args.timing_only:
+        done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
+        have = set(zip(done.get("hidden", []), done.get("seed", []), strict=False))
+        plan = [(e, 100 + s) for e in args.effects.split(",") for s in range(args.seeds)]
+        plan += [(None, 500 + s) for s in range(args.null_seeds)]
+        for effect, seed in plan:
+            if ((effect or "none"), seed) in have:
+                continue
+            row = one_run(effect, seed)
+            print(row, flush=True)
+            pd.DataFrame([row]).to_csv(
+                args.out, mode="a", header=not args.out.exists(), index=False
+            )
+        table = pd.read_csv(args.out)
+        print("\nconfusion matrix (rows: hidden effect, columns: first named; counts of seeds)")
+        print(pd.crosstab(table["hidden"], table["first_named"]).to_string())
+        eff = table[table["hidden"] != "none"]
+        null = table[table["hidden"] == "none"]
+        print("\nper effect: hit rate (named first, interval covers truth, gap halved)")
+        print(eff.groupby("hidden")[["hit", "covers", "halved"]].mean().to_string())
+        if len(eff):
+            print(f"overall hit rate {eff['hit'].mean():.3f} over {len(eff)} runs")
+        if len(null):
+            print(f"null control: nothing named in {null['hit'].mean():.3f} of {len(null)} seeds")
+        print(f"median workflow time per run {table['workflow_seconds'].median():.1f} s")
+    if not args.no_timing:
+        t = default_timing()
+        print(f"\ndefault dataset: {t}")
+
+
+if __name__ == "__main__":
+    main()
