@@ -186,6 +186,8 @@ def simulate_prescribed(
     if phi.ndim != 3 or phi.shape[2] != 2:
         raise ConfigError(f"phi: expected shape (n_trials, n_frames, 2), got {phi.shape}")
     n_trials, n_max = phi.shape[:2]
+    if not dt > 0:
+        raise ConfigError(f"dt: expected a positive sample interval in s, got {dt}")
     configs = (
         [SimConfig()] * n_trials
         if config is None
@@ -208,12 +210,17 @@ def simulate_prescribed(
     for k in range(n_trials):
         if not np.all(np.isfinite(phi[k, : lengths[k]])):
             raise ConfigError(f"phi: trial {k} has non-finite joint angles")
-    p0 = np.zeros((n_trials, 3)) if pose0 is None else np.asarray(pose0, float).reshape(-1, 3)
-    a0 = (
-        np.zeros((n_trials, 4))
-        if flippers0 is None
-        else np.asarray(flippers0, float).reshape(-1, 4)
-    )
+    try:
+        p0 = np.broadcast_to(
+            np.zeros(3) if pose0 is None else np.asarray(pose0, float), (n_trials, 3)
+        ).copy()
+        a0 = np.broadcast_to(
+            np.zeros(4) if flippers0 is None else np.asarray(flippers0, float), (n_trials, 4)
+        ).copy()
+    except ValueError:
+        raise ConfigError(
+            "pose0 / flippers0: expected shapes (n_trials, 3) / (n_trials, 4) or one row"
+        ) from None
     pose = np.full((n_trials, n_max, 3), np.nan)
     vel = np.full((n_trials, n_max, 3), np.nan)
     ang = np.full((n_trials, n_max, 4), np.nan)
