@@ -257,7 +257,10 @@ def preprocess(
             console.print_frame(shown, title="preprocessing versions")
         return
     result = run_preprocess(
-        store, name, parse_param_items(param or []), parse_trial_ids(trials_),
+        store,
+        name,
+        parse_param_items(param or []),
+        parse_trial_ids(trials_),
         progress=not (quiet or json_),
     )
     if json_:

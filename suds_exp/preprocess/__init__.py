@@ -2,7 +2,12 @@
 stored as named, versioned parameter sets."""
 
 from suds_exp.preprocess.errors import PreprocessError
-from suds_exp.preprocess.params import DEFAULTS, parse_param_items, resolve_params
+from suds_exp.preprocess.params import (
+    DEFAULTS,
+    parse_param_items,
+    parse_trial_ids,
+    resolve_params,
+)
 from suds_exp.preprocess.phaser import Phaser
 from suds_exp.preprocess.pipeline import (
     PrepResult,
@@ -20,6 +25,7 @@ __all__ = [
     "list_versions",
     "load_samples",
     "parse_param_items",
+    "parse_trial_ids",
     "preprocess",
     "resolve_params",
     "sample_columns",

@@ -230,11 +230,19 @@ def _smoothed(tr: _Trial, params: dict) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
+def _rate_window_s(tr: _Trial, params: dict) -> float:
+    """Differentiator window, s: ``sg_window_cycles`` gait periods when set and the trial's
+    frequency is known, else ``sg_window_s``."""
+    if params["sg_window_cycles"] > 0 and tr.frequency_hz:
+        return params["sg_window_cycles"] / tr.frequency_hz
+    return params["sg_window_s"]
+
+
 def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser, params: dict):
     k = params["k"]
     dt = 1.0 / tr.rate_hz
     ra, passive = _smoothed(tr, params)
-    w = window_frames(params["sg_window_s"], tr.rate_hz, params["sg_polyorder"], len(tr.t))
+    w = window_frames(_rate_window_s(tr, params), tr.rate_hz, params["sg_polyorder"], len(tr.t))
     po = params["sg_polyorder"]
     dra = derivative(tr.kin.ra, dt, w, po)
     drp = pca.transform_rate(derivative(tr.kin.passive, dt, w, po))
@@ -344,9 +352,9 @@ def preprocess(
     v = prep_versions.c
     with store.write() as conn:
         row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
-        if row is None and name is not None:
-            clash = conn.execute(sa.select(v.id).where(v.name == name)).first()
-            if clash is not None:
+        if name is not None:
+            clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
+            if clash is not None and clash.params_hash != digest:
                 raise PreprocessError(
                     f"--name {name}: version {clash.id} already has that name with other "
                     "parameters; choose another name"
@@ -373,7 +381,9 @@ def preprocess(
 
     # pass 1: clean and measure every trial to do; any refusal stops before writing
     items: list[_Trial] = []
-    with progress_bar("Cleaning", total=len(todo_meta), enabled=progress) as advance:
+    with progress_bar(
+        "Cleaning", total=len(todo_meta), enabled=progress and bool(len(todo_meta))
+    ) as advance:
         for meta_row in todo_meta.itertuples(index=False):
             items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params))
             advance()

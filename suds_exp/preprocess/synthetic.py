@@ -91,9 +91,11 @@ def synthetic_trial(
     flips = np.column_stack([0.6 * (1 + np.sin(theta + 0.8 * i)) for i in range(4)])
 
     # body motion: prescribed body velocity, heading integrated analytically
-    vx = 8.0 + 4.0 * np.cos(2 * theta)
-    vy = 1.5 * np.sin(theta)
-    w0 = rng.uniform(-0.05, 0.05)
+    # displacement per cycle is fixed, as for a rate-independent swimmer: speed ~ frequency
+    speed = 80.0 * frequency_hz  # mm/s
+    vx = speed * (1.0 + 0.5 * np.cos(2 * theta))
+    vy = 0.2 * speed * np.sin(theta)
+    w0 = rng.uniform(-0.1, 0.1) * frequency_hz
     heading = rng.uniform(-np.pi, np.pi) + 0.15 * np.sin(theta) + w0 * t
     wz = 0.15 * omega * np.cos(theta) + w0
     # world position: integrate on a 20x finer grid for accuracy
@@ -101,7 +103,7 @@ def synthetic_trial(
     tf = np.arange((n - 1) * fine + 1) / (rate_hz * fine)
     thf = omega * tf + phase0
     hf = heading[0] - 0.15 * np.sin(phase0) + 0.15 * np.sin(thf) + w0 * tf
-    vxf, vyf = 8.0 + 4.0 * np.cos(2 * thf), 1.5 * np.sin(thf)
+    vxf, vyf = speed * (1.0 + 0.5 * np.cos(2 * thf)), 0.2 * speed * np.sin(thf)
     dx = np.cos(hf) * vxf - np.sin(hf) * vyf
     dy = np.sin(hf) * vxf + np.cos(hf) * vyf
     x = cumulative_trapezoid(dx, tf, initial=0.0)[::fine] + rng.uniform(-200, 200)
