@@ -33,10 +33,11 @@ data are never assumed. Three variants (`augment`):
   ablation.
 - "none": plain GMR.
 
-Measured (benchmarks/models.py, simulator data, 30 training cycles of O at 1/2 Hz):
-"homogeneous" cuts the error at another frequency by ~20-25 % (1 Hz) and on another
-gait by ~30 % (D+) against "none", at equal error on the training condition; "dilation"
-helps less and costs more.
+Measured (benchmarks/models.py --boots 6, simulator data, 30 training cycles of O at
+1/2 Hz, mean RMSE of vx): "homogeneous" against "none" changes the error by -3 % (GMR)
+and +30 % (GMR+SUDS) on the training condition, by -87 % / -74 % at 1 Hz, -76 % / -55 %
+at 1/3 Hz and -46 % / -4 % on gait D+. "dilation" sits in between at 1 Hz and 1/3 Hz and
+is worst on D+.
 
 Branching: the map may be multi-valued, the body moving differently at one
 (r_a, dr_a/dt) depending on recent history (flippers open or closed). Two mechanisms
@@ -56,14 +57,14 @@ Branching: the map may be multi-valued, the body moving differently at one
   shape came from; rate-independent), so the mixture can split a region by history.
 - "none" (default): plain gating h_k(x).
 
-Measured (benchmarks/models.py ablation, 30 cycles of O at 1/2 Hz, 3 draws): "filter"
-changes the error by less than 3 % anywhere: with dr_a/dt among the inputs a periodic
-gait never revisits an (r_a, dr_a/dt) point, so gating on x alone is already
-unambiguous. "history" often helps on the training gait (synthetic swimmer: GMR -16 %
-same condition, -14 % at 1 Hz; simulator: GMR+SUDS -16 % same condition, -25 % at 1 Hz;
-but simulator GMR +9 % same condition) and costs +3 to +50 % on another gait (D+),
-whose history chords lie outside the training data. Since most pairs of a campaign
-cross gaits, both stay available and off by default.
+Measured (same ablation, with "homogeneous"): "filter" changes the error by at most 6 %
+anywhere; with dr_a/dt among the inputs a periodic gait never revisits an
+(r_a, dr_a/dt) point, so gating on x alone is already unambiguous. "history" is a mixed
+bag: on the simulator it cuts GMR+SUDS's error by 35 % on the training condition and by
+53 % at 1 Hz but nearly doubles it on D+ (+93 %); for GMR it is +2 % / +14 % / -15 %
+(same, 1 Hz, D+); on the synthetic swimmer GMR gains 17 % on the training gait and
+loses 41 % on D+. History chords of another gait lie outside the training data, and most
+pairs of a campaign cross gaits, so both mechanisms stay available and off by default.
 
 Rollout (GMR+SUDS, mode="rollout"): r_p starts at each trial's first measured value and
 is integrated by explicit Euler with the predicted dr_p/dt, clipped to the training range
