@@ -36,8 +36,10 @@ data are never assumed. Three variants (`augment`):
 Measured (benchmarks/models.py --boots 6, simulator data, 30 training cycles of O at
 1/2 Hz, mean RMSE of vx): "homogeneous" against "none" changes the error by -3 % (GMR)
 and +30 % (GMR+SUDS) on the training condition, by -87 % / -74 % at 1 Hz, -76 % / -55 %
-at 1/3 Hz and -46 % / -4 % on gait D+. "dilation" sits in between at 1 Hz and 1/3 Hz and
-is worst on D+.
+at 1/3 Hz and -46 % / -4 % on gait D+. "dilation" lies between the two for GMR; for
+GMR+SUDS it beats "homogeneous" on the training condition (2.74 against 3.59 mm/s) and
+at 1 Hz (7.66 against 11.65) but loses at 1/3 Hz (6.96 against 3.41); on D+ it is the
+worst of the three for both learners.
 
 Branching: the map may be multi-valued, the body moving differently at one
 (r_a, dr_a/dt) depending on recent history (flippers open or closed). Two mechanisms
