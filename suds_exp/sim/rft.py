@@ -13,10 +13,15 @@ four hinge opening rates. Equations: 3 force/torque balances on the whole robot 
 torque balances at the hinges (medium + spring [+ damping]); a hinge resting on a stop
 with the net torque pushing into it is held (u = 0, the stop takes the torque), which is
 decided by a small active-set loop. Solved by damped Newton with an analytic Jacobian,
-warm-started from the previous step; continuation on the smoothing scale only when
-Newton fails.
+warm-started from the previous step (body twist extrapolated linearly) and with a capped
+step; Levenberg-Marquardt and continuation on the smoothing scale only when Newton fails.
+Each step solves at the midpoint of the joint path (phi interpolated linearly between
+samples, d(phi)/dt the secant), flipper angles predicted half a step ahead; the pose is
+advanced with the SE(2) exponential of the twist.
 
-Layout of the per-trial parameter vector `prm` (indices P_*):
+Per-trial parameters come in a vector `prm` of N_PARAMS (indices P_*), packed by
+`suds_exp.sim.mechanics.pack_params` in the scaled units above; body inertia relaxes the
+twist towards the quasi-static one with factor 1 - exp(-h / tau) per step.
 """
 
 from __future__ import annotations
