@@ -248,7 +248,7 @@ def run_campaign(
                 )
         check_feasible(bank, plan.train_conditions, plan.test_conditions, _max_cycles(plan))
         done = finished_keys(store, name)
-        n_workers = _n_workers(jobs, backend, scheduler)
+        n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
             plan, done, chunk_jobs or _default_chunk(len(done), plan, n_workers)
         )
@@ -291,7 +291,7 @@ def _resolve_prep(store: Store, prep: str | None) -> str:
     return by_id.get(prep, prep)
 
 
-def _n_workers(jobs: int, backend: str, scheduler: str | None) -> int:
+def _n_workers(jobs: int) -> int:
     if jobs == -1:
         return os.cpu_count() or 1
     return jobs
@@ -373,27 +373,32 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
     from joblib import Parallel, delayed, parallel_config
 
     if backend == "loky":
+        from joblib.externals.loky.backend import resource_tracker
+
         folder = stack.enter_context(tempfile.TemporaryDirectory(prefix="suds_bank_"))
+        # loky's resource tracker removes the folder if this process dies (kill -9).
+        resource_tracker.register(folder, "folder")
+        stack.callback(resource_tracker.unregister, folder, "folder")
         shared = bank.memmapped(folder)
         stack.enter_context(parallel_config(backend="loky", n_jobs=jobs))
     else:
         from dask.distributed import Client, LocalCluster
 
         if scheduler:
-            client = stack.enter_context(Client(scheduler))
+            stack.enter_context(Client(scheduler))
         else:
             cluster = stack.enter_context(
                 LocalCluster(
-                    n_workers=max(jobs, 1),
+                    n_workers=_n_workers(jobs),
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
                 )
             )
-            client = stack.enter_context(Client(cluster))
+            stack.enter_context(Client(cluster))
+        # Scattered once to every worker; joblib swaps the argument for its future.
         shared = bank
         stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
-        del client
     gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
         delayed(run_chunk)(shared, c, *args) for c in chunks
     )
