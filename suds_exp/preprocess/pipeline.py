@@ -27,7 +27,13 @@ from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.rates import body_velocity, derivative, smooth, window_frames
+from suds_exp.preprocess.rates import (
+    body_velocity,
+    derivative,
+    differentiator_window,
+    smooth,
+    window_frames,
+)
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
     DRP_COLUMNS,
@@ -230,19 +236,11 @@ def _smoothed(tr: _Trial, params: dict) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
-def _rate_window_s(tr: _Trial, params: dict) -> float:
-    """Differentiator window, s: ``sg_window_cycles`` gait periods when set and the trial's
-    frequency is known, else ``sg_window_s``."""
-    if params["sg_window_cycles"] > 0 and tr.frequency_hz:
-        return params["sg_window_cycles"] / tr.frequency_hz
-    return params["sg_window_s"]
-
-
 def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser, params: dict):
     k = params["k"]
     dt = 1.0 / tr.rate_hz
     ra, passive = _smoothed(tr, params)
-    w = window_frames(_rate_window_s(tr, params), tr.rate_hz, params["sg_polyorder"], len(tr.t))
+    w = differentiator_window(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
     po = params["sg_polyorder"]
     dra = derivative(tr.kin.ra, dt, w, po)
     drp = pca.transform_rate(derivative(tr.kin.passive, dt, w, po))

@@ -25,6 +25,18 @@ def window_frames(window_s: float, rate_hz: float, polyorder: int, n_frames: int
     return min(w, limit)
 
 
+def differentiator_window(
+    params: dict, rate_hz: float, frequency_hz: float | None, n_frames: int
+) -> int:
+    """A version's differentiator window, frames: ``sg_window_cycles`` gait periods when set
+    and the trial's frequency (Hz) is known, else ``sg_window_s`` seconds."""
+    if params["sg_window_cycles"] > 0 and frequency_hz:
+        window_s = params["sg_window_cycles"] / frequency_hz
+    else:
+        window_s = params["sg_window_s"]
+    return window_frames(window_s, rate_hz, params["sg_polyorder"], n_frames)
+
+
 def derivative(x: np.ndarray, dt: float, window: int, polyorder: int) -> np.ndarray:
     """Time derivative of ``x`` (n_frames, ...) along axis 0; units of x per second.
 

@@ -9,13 +9,15 @@ command's zero).
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from suds_exp.preprocess.errors import PreprocessError
-from suds_exp.preprocess.pipeline import load_samples
+from suds_exp.preprocess.pipeline import _find_version, load_samples
+from suds_exp.preprocess.rates import body_velocity, differentiator_window
 from suds_exp.store import Store
 
 
@@ -36,11 +38,18 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
 
     Columns: ``trial_id`` (``-1`` = all trials pooled), ``gait``, ``frequency_hz``,
     ``n``, ``rms_vx_true`` (mm/s), ``err_vx``, ``err_vy`` (mm/s), ``err_wz`` (rad/s),
-    ``err_ra`` (rad), ``err_phase`` (rad). Trials without a truth file are left out.
+    ``err_ra`` (rad), ``err_phase`` (rad), and ``err_vx_band``, ``err_vy_band``,
+    ``err_wz_band``: the body-velocity errors against the truth pose passed through the
+    version's own differentiator, i.e. what the markers and the body frame cost, without
+    the truth's content above the differentiator's band. Trials without a truth file are
+    left out.
     """
     samples = load_samples(store, version)
-    files = store.query_df("SELECT id, source_file FROM trials")
+    files = store.query_df("SELECT id, source_file, sample_rate_hz FROM trials")
     source = dict(zip(files.id, files.source_file, strict=True))
+    rate = dict(zip(files.id, files.sample_rate_hz, strict=True))
+    with store.read() as conn:
+        params = json.loads(_find_version(conn, version).params)
     rows, pooled = [], []
     for tid, s in samples.groupby("trial_id", sort=True):
         path = truth_path(source[tid])
@@ -49,6 +58,11 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
         truth = pd.read_parquet(path)
         if len(truth) != len(s):
             raise PreprocessError(f"{path}: {len(truth)} rows, but trial {tid} has {len(s)} frames")
+        heading = np.unwrap(truth.theta.to_numpy())
+        window = differentiator_window(params, rate[tid], s.frequency_hz.iloc[0], len(truth))
+        band = body_velocity(
+            truth[["x", "y"]].to_numpy(), heading, 1.0 / rate[tid], window, params["sg_polyorder"]
+        )
         e = pd.DataFrame(
             {
                 "vx": s.vx.to_numpy() - truth.vx.to_numpy(),
@@ -57,6 +71,9 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
                 "ra1": s.ra_1.to_numpy() - truth.phi1.to_numpy(),
                 "ra2": s.ra_2.to_numpy() - truth.phi2.to_numpy(),
                 "phase": _phase_error(s.phase.to_numpy(), truth.phase_cmd.to_numpy()),
+                "vx_band": s.vx.to_numpy() - band[:, 0],
+                "vy_band": s.vy.to_numpy() - band[:, 1],
+                "wz_band": s.wz.to_numpy() - band[:, 2],
                 "vx_true": truth.vx.to_numpy(),
             }
         )
@@ -83,4 +100,7 @@ def _summary(e: pd.DataFrame, tid, gait, freq) -> dict:
         "err_wz": rms(e.wz),
         "err_ra": rms(np.concatenate([e.ra1, e.ra2])),
         "err_phase": rms(e.phase),
+        "err_vx_band": rms(e.vx_band),
+        "err_vy_band": rms(e.vy_band),
+        "err_wz_band": rms(e.wz_band),
     }

