@@ -7,6 +7,7 @@ import json
 import shutil
 from pathlib import Path
 
+import duckdb
 import numpy as np
 import pandas as pd
 import pytest
@@ -232,3 +233,47 @@ def test_a_name_used_by_other_parameters_is_refused(dataset):
     assert json.loads(same.stdout)["skipped"] == [1, 2, 3, 4, 5]
     frame = pd.DataFrame(sql(dataset, "SELECT name FROM prep_versions"))
     assert frame.name.tolist() == ["base"]
+
+
+def test_trials_with_their_own_marker_names_are_read_through_their_layout(tmp_path):
+    trial = synthetic_trial("D+", 0.5, n_cycles=4, seed=5)
+    path = write_marker_csv(trial, tmp_path / "named.csv")
+    text = path.read_text()
+    for i in range(1, 5):
+        text = text.replace(f"flipper_{i}_", f"fl{i}_")
+    path.write_text(text.replace("head_spoke_", "HS_"))
+    layout = tmp_path / "layout.csv"
+    names = {f"flipper_{i}": f"fl{i}" for i in range(1, 5)} | {"head_spoke": "HS"}
+    roles = [
+        "head_top_1",
+        "head_top_2",
+        "head_spoke",
+        "tail_top_1",
+        "tail_top_2",
+        "tail_spoke",
+        "tail_back",
+        "flipper_1",
+        "flipper_2",
+        "flipper_3",
+        "flipper_4",
+    ]
+    layout.write_text("role,marker\n" + "".join(f"{r},{names.get(r, r)}\n" for r in roles))
+    db = tmp_path / "db.duckdb"
+    ingest_paths(Store(db), [path], layout=layout, progress=False)
+    # the same capture under the default names gives the same samples
+    (tmp_path / "plain").mkdir()
+    plain = write_marker_csv(trial, tmp_path / "plain" / "named.csv")
+    db2 = tmp_path / "db2.duckdb"
+    ingest_paths(Store(db2), [plain], progress=False)
+    a = load_samples(Store(db), preprocess(Store(db), progress=False).version_id)
+    b = load_samples(Store(db2), preprocess(Store(db2), progress=False).version_id)
+    pd.testing.assert_frame_equal(
+        a.drop(columns=["gait", "frequency_hz"]), b.drop(columns=["gait", "frequency_hz"])
+    )
+
+
+def test_a_database_without_preprocessing_is_told_what_to_do(tmp_path):
+    db = tmp_path / "old.duckdb"
+    duckdb.connect(str(db)).close()
+    with pytest.raises(PreprocessError, match="no preprocessing tables yet"):
+        load_samples(Store(db), 1)

@@ -111,6 +111,18 @@ def _find_version(conn: sa.Connection, version: int | str) -> sa.Row:
     return row
 
 
+def _require_tables(conn: sa.Connection) -> None:
+    """Refuse a database made before preprocessing existed (its migration not applied)."""
+    found = conn.exec_driver_sql(
+        "SELECT count(*) FROM information_schema.tables WHERE table_name = 'prep_versions'"
+    ).scalar_one()
+    if not found:
+        raise PreprocessError(
+            "this database has no preprocessing tables yet; run `suds-exp preprocess` "
+            "(or `suds-exp init` to upgrade it)"
+        )
+
+
 def _group_key(kind: str, trial_id: int, gait: str | None, frequency_hz: float | None) -> str:
     if kind == "all":
         return "all"
@@ -549,6 +561,7 @@ def load_samples(
     vx, vy (mm/s), wz (rad/s)`` (body frame) and the trial's ``gait``, ``frequency_hz``.
     """
     with store.read() as conn:
+        _require_tables(conn)
         row = _find_version(conn, version)
         cols = sample_columns(row.k)
         select = ", ".join(f's."{c}"' for c in cols)
@@ -569,6 +582,8 @@ def load_samples(
 def list_versions(store: Store) -> pd.DataFrame:
     """One row per version: id, name, params_hash, k, trials done, samples, created_at,
     kept explained variance (fraction)."""
+    with store.read() as conn:
+        _require_tables(conn)
     return store.query_df(
         """
         SELECT v.id, v.name, v.params_hash, v.k,
