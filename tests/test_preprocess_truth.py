@@ -9,6 +9,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pytest
 
 from suds_exp.preprocess import preprocess
@@ -76,3 +78,28 @@ def test_default_dataset_body_velocity_within_5_percent_of_raw_truth(default_dat
     pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]
     for column in ("err_vx", "err_vy", "err_wz"):
         assert pooled[column] <= 0.05 * pooled.rms_vx_true, column
+
+
+def test_cleaning_finds_the_simulators_jumps_and_keeps_every_clean_point(small):
+    from suds_exp.preprocess.clean import clean_tracks
+    from suds_exp.preprocess.truth import truth_path
+    from suds_exp.sim.config import SimConfig
+    from suds_exp.sim.dataset import truth_markers
+    from suds_exp.sim.markers import measure
+
+    cfg = SimConfig()
+    cfg.measurement.jump_prob = 3e-3  # 20x the nominal rate, for a few hundred jumps
+    rng = np.random.default_rng(7)
+    injected = found = wrongly_removed = 0
+    for source in small.query_df("SELECT source_file FROM trials ORDER BY id").source_file:
+        true = truth_markers(pd.read_parquet(truth_path(source)), cfg)
+        measured = measure(cfg, true, rng)
+        # noise is 0.2 mm and the spokes ring by at most ~2 mm: beyond 6 mm is a jump
+        jumped = np.linalg.norm(measured - true, axis=2) > 6.0
+        removed = clean_tracks(measured, jump_mm=9.0).removed
+        injected += int(jumped.sum())
+        found += int((removed & jumped).sum())
+        wrongly_removed += int((removed & ~jumped).sum())
+    assert injected > 200
+    assert found == injected
+    assert wrongly_removed == 0

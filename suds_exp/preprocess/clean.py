@@ -63,19 +63,38 @@ class CleanResult:
         return float(self.filled.mean()) if self.filled.size else 0.0
 
 
-def _point_velocity(xyz: np.ndarray) -> np.ndarray:
-    """Each frame's marker velocity, (n_frames, n_markers, 3) mm/frame: the running median
-    of the frame-to-frame steps around it (robust to the few steps a jump spoils), with
-    steps next to unseen frames interpolated from their neighbours."""
+def _point_velocity(xyz: np.ndarray, jump_mm: float) -> np.ndarray:
+    """Each frame's marker velocity, (n_frames, n_markers, 3) mm/frame.
+
+    The running median of the frame-to-frame steps around the frame (mirrored at the
+    ends), leaving out the steps next to a change of step larger than half the jump
+    threshold (a jump, or clean motion no marker makes: ~1 mm per frame squared here),
+    with the left-out steps and those next to unseen frames interpolated from their
+    neighbours; so a jump next to a gap or an end of the record cannot drag it along.
+    """
     n, m, _ = xyz.shape
     if n < 2:
         return np.zeros_like(xyz)
-    steps = (xyz[1:] - xyz[:-1]).reshape(n - 1, -1)
-    rows = np.arange(n - 1)
-    for col in np.flatnonzero(np.isnan(steps).any(axis=0)):
-        ok = ~np.isnan(steps[:, col])
-        steps[:, col] = np.interp(rows, rows[ok], steps[ok, col]) if ok.any() else 0.0
-    med = median_filter(steps, size=(MEDIAN_STEPS, 1), mode="nearest")
+    raw = (xyz[1:] - xyz[:-1]).reshape(n - 1, -1)
+
+    def running_median(steps: np.ndarray) -> np.ndarray:
+        steps = steps.copy()
+        rows = np.arange(n - 1)
+        for col in np.flatnonzero(np.isnan(steps).any(axis=0)):
+            ok = ~np.isnan(steps[:, col])
+            steps[:, col] = np.interp(rows, rows[ok], steps[ok, col]) if ok.any() else 0.0
+        return median_filter(steps, size=(MEDIAN_STEPS, 1), mode="mirror")
+
+    # a step next to a large change of step (second difference) may be a jump: leave it
+    # out of the median, whatever the gaps around it
+    steps = raw.reshape(n - 1, m, 3)
+    change = np.linalg.norm(np.diff(steps, axis=0), axis=2) > 0.5 * jump_mm
+    spoiled = np.zeros((n - 1, m), dtype=bool)
+    spoiled[:-1] |= change
+    spoiled[1:] |= change
+    cleaned = steps.copy()
+    cleaned[spoiled] = np.nan
+    med = running_median(cleaned.reshape(n - 1, -1))
     return np.vstack([med[:1], med]).reshape(n, m, 3)
 
 
@@ -91,6 +110,8 @@ def _bad_runs(
         return bad, 0
     gaps = np.diff(index)
 
+    fast = float(np.percentile(np.linalg.norm(velocity, axis=1), 99))
+
     def miss(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """How far points b lie from points a moved on at the mean of their velocities,
         and the allowance for the change of velocity over the frames between, mm."""
@@ -98,11 +119,15 @@ def _bad_runs(
         mean_v = 0.5 * (velocity[a] + velocity[b])
         off = np.linalg.norm(points[b] - points[a] - mean_v * frames, axis=1)
         n = np.abs(frames[:, 0])
-        # next frame: the change of velocity; across a gap the running median lags the
-        # motion, so allow the marker's whole travel at its faster end's speed
+        # Over seen frames: the change of velocity. Across unseen ones the velocity at the
+        # gap's ends is poorly known (fast, accelerating flippers), so allow the marker's
+        # whole travel at the faster of its ends' speeds and its typical high speed: a
+        # jump hidden by a gap may pass, a clean run is not thrown away.
         speed = np.maximum(np.linalg.norm(velocity[a], axis=1), np.linalg.norm(velocity[b], axis=1))
-        turn = np.where(n <= 1, 0.5 * np.linalg.norm(velocity[b] - velocity[a], axis=1), n * speed)
-        return off, turn
+        speed = np.maximum(speed, fast)
+        unseen = (index[b] - index[a]) != (b - a)  # the span crosses unseen frames
+        change = 0.5 * np.linalg.norm(velocity[b] - velocity[a], axis=1) * n
+        return off, np.where(unseen, n * speed, change)
 
     pairs = np.arange(len(points) - 1)
     excess, turn = miss(pairs, pairs + 1)
@@ -169,7 +194,7 @@ def clean_tracks(
     names = list(marker_names) if marker_names is not None else [str(i) for i in range(n_markers)]
     seen = np.isfinite(xyz).all(axis=2)
     removed = np.zeros_like(seen)
-    velocity = _point_velocity(xyz)
+    velocity = _point_velocity(xyz, jump_mm)
     out = np.empty_like(xyz)
     frames = np.arange(n_frames)
     n_jumps = 0
