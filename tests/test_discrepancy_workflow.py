@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 from cli import app
 from suds_exp.discrepancy import candidates_for, draw_hidden, hidden_effect_run
 from suds_exp.discrepancy.demo import HIDDEN, simulate_measured
+from suds_exp.discrepancy.effects import effect_parameters
 from suds_exp.sim.config import SimConfig
 from suds_exp.store import Store
 
@@ -137,13 +138,18 @@ def test_candidates_are_the_effects_the_model_lacks():
     assert "flippers=free" in labels and "hinge_damping" not in labels
 
 
-def test_hidden_values_are_drawn_inside_the_realistic_range():
+def test_hidden_values_are_drawn_inside_the_realistic_range_away_from_off():
     rng = np.random.default_rng(1)
     for effect, (_, param) in HIDDEN.items():
+        spec = next(p for p in effect_parameters(effect) if p["name"] == param)
+        lo, hi = spec["range"]
+        off = spec["off"] if not isinstance(spec["off"], str) else lo
         for _ in range(20):
             v = draw_hidden(effect, rng)[param]
-            cand = next(c for c in candidates_for(SimConfig()) if c.effect == effect and c.param)
-            assert cand.bounds[0] <= v <= cand.bounds[1]
+            assert lo <= v <= hi
+            # at least 35% of the way from "off" to the end of the range on its side
+            end = hi if v > off else lo
+            assert abs(v - off) >= 0.35 * abs(end - off) - 1e-12
 
 
 # -- slow sweeps ------------------------------------------------------------------------

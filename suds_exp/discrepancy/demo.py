@@ -26,6 +26,7 @@ HIDDEN: dict[str, tuple[dict, str]] = {
     "asymmetric_drag": ({}, "ratio"),
     "drag_anisotropy": ({}, "normal_scale"),
     "medium_compaction": ({}, "rate_per_m"),
+    "spoke_oscillation": ({}, "gain"),
 }
 
 
@@ -109,15 +110,23 @@ def hidden_effect_run(
 ) -> HiddenRun:
     """Simulate "measured" data with ``hidden`` effects ({effect: settings}, e.g.
     ``{"body_inertia": {"tau_s": 0.2}}``; None or {}: the nominal robot) and run the
-    workflow on it starting from ``model`` (default nominal).
+    workflow on it starting from ``model`` (default: nominal, with every hidden effect
+    switched off).
 
     Returns the hidden settings and the workflow's result (``result.named``,
     ``result.gap_before``, ``result.gap_after``).
     """
     hidden = dict(hidden or {})
     truth = SimConfig()
+    start = model or SimConfig()
     for effect, settings in hidden.items():
         truth = set_effect(truth, effect, settings)
+        if model is None:
+            # an effect the nominal robot already has (spoke_oscillation) is hidden by
+            # starting from a model without it
+            spec = main_parameter(effect)
+            if not isinstance(spec["off"], str):
+                start = set_effect(start, effect, {spec["name"]: spec["off"]})
     opts = options or DiscrepancyOptions(seed=seed)
     with tempfile.TemporaryDirectory(prefix="suds-discrepancy-") as tmp:
         base = Path(workdir) if workdir is not None else Path(tmp)

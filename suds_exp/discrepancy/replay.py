@@ -28,7 +28,14 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import savgol_filter
 
+from suds_exp.preprocess.shape import PASSIVE_ROLES
 from suds_exp.sim.config import SimConfig
+from suds_exp.sim.markers import (
+    MARKER_NAMES,
+    SPOKE_MARKERS,
+    rigid_marker_positions,
+    spoke_deflection,
+)
 from suds_exp.sim.mechanics import simulate_prescribed
 
 CHANNELS = ("vx", "vy", "wz")
@@ -55,7 +62,11 @@ class ReplaySettings:
         Scaled residual tolerance of the simulator's per-step solve during replay.
     ra_smooth_s : float
         Savitzky-Golay smoothing window (s) applied to the measured r_a before it drives
-        the replay, against marker noise; 0 replays it as measured.
+        the replay, against marker noise; 0 replays it as measured (the samples' r_a is
+        already smoothed by the preprocessing).
+    shape_window_s, shape_polyorder : float, int
+        The preprocessing version's smoothing of the passive state (applied to the
+        replayed passive state too).
     """
 
     windows_per_trial: int = 2
@@ -67,6 +78,8 @@ class ReplaySettings:
     sg_polyorder: int = 3
     solver_tol: float = 1e-7
     ra_smooth_s: float = 0.0
+    shape_window_s: float = 0.21
+    shape_polyorder: int = 5
 
 
 @dataclass
@@ -92,6 +105,7 @@ class WindowGroup:
     score_from: int
     n_scored: int
     sg_frames: int
+    ra_fine: np.ndarray | None = None
 
 
 @dataclass
@@ -105,6 +119,14 @@ class WindowSet:
     info: pd.DataFrame
     groups: list[WindowGroup]
     settings: ReplaySettings
+    pca: object | None = None
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """Compared channels: vx, vy, wz, then rp_1..rp_k when the passive shape is."""
+        if self.pca is None:
+            return CHANNELS
+        return CHANNELS + tuple(f"rp_{i + 1}" for i in range(self.pca.n_components))
 
     @property
     def trial_id(self) -> np.ndarray:
@@ -134,9 +156,10 @@ class WindowSet:
                     g.score_from,
                     g.n_scored,
                     g.sg_frames,
+                    None if g.ra_fine is None else g.ra_fine[m],
                 )
             )
-        return WindowSet(self.info[keep].reset_index(drop=True), groups, self.settings)
+        return WindowSet(self.info[keep].reset_index(drop=True), groups, self.settings, self.pca)
 
 
 def settings_from_prep(params: dict, **overrides) -> ReplaySettings:
@@ -145,6 +168,8 @@ def settings_from_prep(params: dict, **overrides) -> ReplaySettings:
         sg_window_s=float(params.get("sg_window_s", 0.21)),
         sg_window_cycles=float(params.get("sg_window_cycles", 0.0)),
         sg_polyorder=int(params.get("sg_polyorder", 3)),
+        shape_window_s=float(params.get("shape_window_s", 0.21)),
+        shape_polyorder=int(params.get("shape_polyorder", 5)),
         **overrides,
     )
 
@@ -154,8 +179,15 @@ def _odd_window(window_s: float, dt: float, polyorder: int) -> int:
     return w + 1 - w % 2
 
 
-def make_windows(samples: pd.DataFrame, settings: ReplaySettings | None = None) -> WindowSet:
+def make_windows(
+    samples: pd.DataFrame, settings: ReplaySettings | None = None, pca=None
+) -> WindowSet:
     """Cut measured trials into replay windows.
+
+    With ``pca`` (the preprocessing version's `PassivePCA`) the passive shape r_p is
+    compared too: the replay computes the markers, their passive coordinates and r_p
+    exactly as the preprocessing did, and both sides lose their mean over each window
+    (a constant offset of the estimated segment origins is not physics).
 
     Parameters
     ----------
@@ -193,6 +225,10 @@ def make_windows(samples: pd.DataFrame, settings: ReplaySettings | None = None) 
             ra_s = savgol_filter(ra, w, s.sg_polyorder, axis=0)
         meas = tr[list(CHANNELS)].to_numpy(float)
         speed = np.hypot(meas[:, 0], meas[:, 1])
+        if pca is not None:
+            meas = np.column_stack(
+                [meas, tr[[f"rp_{i + 1}" for i in range(pca.n_components)]].to_numpy(float)]
+            )
         # path length from the trial's start (mm -> m); before the first kept sample
         # the robot is assumed to have moved at its mean speed
         dist = (
@@ -215,6 +251,7 @@ def make_windows(samples: pd.DataFrame, settings: ReplaySettings | None = None) 
                     ra[sc],
                     t[sc],
                     dist[a],
+                    ra_s[a : a + n_total],
                 )
             )
             rows.append(
@@ -228,14 +265,17 @@ def make_windows(samples: pd.DataFrame, settings: ReplaySettings | None = None) 
             )
     groups = []
     for (dt, step, n_total, n_warm, n_score, sg), items in per_group.items():
-        idx, phi, meas, phase, ra, tt, d0 = zip(*items, strict=True)
+        idx, phi, meas, phase, ra, tt, d0, ra_fine = zip(*items, strict=True)
+        meas = np.stack(meas)
+        if pca is not None:
+            meas[..., 3:] -= meas[..., 3:].mean(axis=1, keepdims=True)
         groups.append(
             WindowGroup(
                 dt=dt,
                 step=step,
                 index=np.array(idx),
                 phi=np.stack(phi),
-                measured=np.stack(meas),
+                measured=meas,
                 phase=np.stack(phase),
                 ra=np.stack(ra),
                 t=np.stack(tt),
@@ -244,9 +284,10 @@ def make_windows(samples: pd.DataFrame, settings: ReplaySettings | None = None) 
                 score_from=n_warm,
                 n_scored=n_score,
                 sg_frames=sg,
+                ra_fine=np.stack(ra_fine),
             )
         )
-    return WindowSet(pd.DataFrame(rows), groups, s)
+    return WindowSet(pd.DataFrame(rows), groups, s, pca)
 
 
 def _window_config(cfg: SimConfig, d0_m: float, tol: float) -> SimConfig:
@@ -270,13 +311,14 @@ def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
 
     Returns
     -------
-    array of shape (n_configs, n_windows, n_scored_max, 3)
-        vx, vy (mm/s), wz (rad/s), body frame, through the measurement's differentiator;
-        NaN past a window's scored length.
+    array of shape (n_configs, n_windows, n_scored_max, n_channels)
+        vx, vy (mm/s), wz (rad/s), body frame, through the measurement's differentiator,
+        then (with a PCA) r_p minus its window mean (mm); NaN past a window's scored
+        length. Channels: ``windows.channels``.
     """
     n_win = len(windows.info)
     n_max = max((g.n_scored for g in windows.groups), default=0)
-    out = np.full((len(configs), n_win, n_max, 3), np.nan)
+    out = np.full((len(configs), n_win, n_max, len(windows.channels)), np.nan)
     s = windows.settings
     for g in windows.groups:
         n = len(g.index)
@@ -299,14 +341,66 @@ def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
         vx = c * rates[:, sc, 0] + sn * rates[:, sc, 1]
         vy = -sn * rates[:, sc, 0] + c * rates[:, sc, 1]
         vel = np.stack([vx, vy, rates[:, sc, 2]], axis=-1).reshape(len(configs), n, g.n_scored, 3)
-        out[:, g.index, : g.n_scored] = vel
+        out[:, g.index, : g.n_scored, :3] = vel
+        if windows.pca is not None:
+            rp = _passive(windows, g, configs, fine, sim["flippers"], dt_cap)[:, sc]
+            rp = rp - rp.mean(axis=1, keepdims=True)
+            out[:, g.index, : g.n_scored, 3:] = rp.reshape(len(configs), n, g.n_scored, -1)
     return out
 
 
+def _passive(windows, g: WindowGroup, configs, pose_fine, flippers, dt_cap) -> np.ndarray:
+    """Replayed r_p, (n_configs * n_windows, n_fine, k) mm, the preprocessing's way:
+    markers (with the spokes' oscillation) -> coordinates in the segment frames ->
+    smoothing -> PCA projection."""
+    s = windows.settings
+    n_b, n_fine = pose_fine.shape[:2]
+    n_cfg = len(configs)
+    n = n_b // n_cfg
+    # flipper angles: linear between the simulator's (decimated) steps
+    k = np.arange(n_fine) / g.step
+    lo = np.minimum(np.floor(k).astype(int), flippers.shape[1] - 1)
+    hi = np.minimum(lo + 1, flippers.shape[1] - 1)
+    frac = (k - lo)[None, :, None]
+    fl = flippers[:, lo] * (1 - frac) + flippers[:, hi] * frac
+    phi = np.tile(g.ra_fine, (n_cfg, 1, 1))
+    pos = rigid_marker_positions(
+        configs[0], pose_fine.reshape(-1, 3), phi.reshape(-1, 2), fl.reshape(-1, 4)
+    ).reshape(n_b, n_fine, len(MARKER_NAMES), 3)
+    for b in range(n_b):
+        cfg = configs[b // n]
+        if cfg.effects.spoke_oscillation.gain == 0:
+            continue
+        for name in SPOKE_MARKERS:
+            j = MARKER_NAMES.index(name)
+            pos[b, :, j, :2] += spoke_deflection(cfg, pos[b, :, j, :2], dt_cap)
+    half = configs[0].geometry.middle_length_mm / 2
+    x, y, th = pose_fine[..., 0], pose_fine[..., 1], pose_fine[..., 2]
+    c, sn = np.cos(th), np.sin(th)
+    frames = {
+        "head": (x + c * half, y + sn * half, th + phi[..., 0]),
+        "tail": (x - c * half, y - sn * half, th - phi[..., 1]),
+    }
+    cols = []
+    for role, segment in PASSIVE_ROLES:
+        ox, oy, heading = frames[segment]
+        j = MARKER_NAMES.index(role)
+        dx, dy = pos[..., j, 0] - ox, pos[..., j, 1] - oy
+        ch, sh = np.cos(heading), np.sin(heading)
+        cols += [ch * dx + sh * dy, -sh * dx + ch * dy]
+    passive = np.stack(cols, axis=-1)
+    if s.shape_window_s > 0:
+        w = min(_odd_window(s.shape_window_s, dt_cap, s.shape_polyorder), n_fine - 1 + n_fine % 2)
+        if w > s.shape_polyorder:
+            passive = savgol_filter(passive, w, s.shape_polyorder, axis=1)
+    return windows.pca.transform(passive.reshape(-1, 12)).reshape(n_b, n_fine, -1)
+
+
 def measured(windows: WindowSet) -> np.ndarray:
-    """Measured body velocity of every window, (n_windows, n_scored_max, 3), NaN padded."""
+    """Measured channels of every window, (n_windows, n_scored_max, n_channels), NaN
+    padded (channels as `replay`)."""
     n_max = max((g.n_scored for g in windows.groups), default=0)
-    out = np.full((len(windows.info), n_max, 3), np.nan)
+    out = np.full((len(windows.info), n_max, len(windows.channels)), np.nan)
     for g in windows.groups:
         out[g.index, : g.n_scored] = g.measured
     return out

@@ -235,16 +235,19 @@ def score_candidates(
     """Score every fitted candidate on the held-out windows, in one simulator call.
 
     Fills each result's test losses and its one-sided paired t-test over held-out
-    trials of log(loss_before / loss_after) > -log(1 - min_improvement), Bonferroni
-    corrected for the number of candidates. Returns (test trial ids, base losses).
+    trials that the relative loss reduction 1 - loss_after / loss_before exceeds
+    ``min_improvement``, Bonferroni corrected for the number of candidates. The relative
+    reduction (at most 1) keeps a trial the candidate fixes completely from dominating
+    the test the way a log ratio would. Returns (test trial ids, base losses).
     """
     started = time.perf_counter()
     trials, loss = _loss_on(test, [base] + [r.config for r in results], scales)
     share = (time.perf_counter() - started) / max(len(results), 1)
-    margin = -np.log1p(-settings.min_improvement)
+    margin = settings.min_improvement
     for k, r in enumerate(results):
         r.test_trials, r.test_before, r.test_after = trials, loss[0], loss[k + 1]
-        d = np.log(loss[0]) - np.log(loss[k + 1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            d = 1.0 - loss[k + 1] / loss[0]
         if len(d) < 2 or not np.all(np.isfinite(d)):
             p = 1.0 if not np.all(np.isfinite(d)) else float(d.mean() <= margin)
         elif np.allclose(d, d[0]):

@@ -59,6 +59,11 @@ class DiscrepancyOptions:
     refine : bool
         Re-fit the accepted candidate's parameter at the capture rate (no decimation), so
         its value and interval are not biased by the replay's discretisation.
+    passive : bool
+        Compare the passive shape r_p too (when the preprocessing version has one); the
+        loss then weighs body velocity and passive shape half and half. Off by default:
+        the benchmarks were measured on body velocity alone; on makes `spoke_oscillation`
+        (markers only) fittable, though weakly, since r_p keeps only k PCA components.
     gap_floor : float
         Held-out loss (mean squared residual over each channel's mean square, so 0.01 is
         a residual of about 10% of the signal) below which a remaining gap is called
@@ -71,6 +76,7 @@ class DiscrepancyOptions:
     replay: ReplaySettings | None = None
     fit: FitSettings = field(default_factory=FitSettings)
     refine: bool = True
+    passive: bool = True
     gap_floor: float = 0.01
 
     def to_dict(self) -> dict:
@@ -259,7 +265,20 @@ def _resolve_prep(store, prep: str | int | None) -> tuple[str, dict]:
             )
         row = hit.iloc[0]
     params = row["params"]
-    return str(row["name"]), json.loads(params) if isinstance(params, str) else dict(params)
+    params = json.loads(params) if isinstance(params, str) else dict(params)
+    return str(row["name"]), params, int(row["id"])
+
+
+def load_pca(store, version_id: int):
+    """The `PassivePCA` of a preprocessing version (None if it has none)."""
+    from suds_exp.preprocess.shape import PassivePCA
+
+    state = store.query_df(
+        "SELECT state FROM prep_fits WHERE version_id = ? AND kind = 'pca'", [version_id]
+    )
+    if state.empty:
+        return None
+    return PassivePCA.from_dict(json.loads(state["state"].iloc[0]))
 
 
 def _full_rate(rs: ReplaySettings) -> ReplaySettings:
@@ -267,6 +286,18 @@ def _full_rate(rs: ReplaySettings) -> ReplaySettings:
     return dataclasses.replace(
         rs, samples_per_cycle=10**6, warmup_cycles=max(1.5, rs.warmup_cycles)
     )
+
+
+def _scales(meas: np.ndarray) -> np.ndarray:
+    """Per-channel divisors of the residual: each channel's measured RMS, and, when the
+    passive shape is compared (more than 3 channels), weighted so body velocity and
+    passive shape count half each."""
+    rms = np.sqrt(np.nanmean(meas**2, axis=(0, 1)))
+    n = meas.shape[-1]
+    if n == 3:
+        return rms
+    weights = np.r_[np.full(3, 0.5 / 3), np.full(n - 3, 0.5 / (n - 3))]
+    return rms / np.sqrt(n * weights)
 
 
 def _rmse(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
@@ -322,14 +353,16 @@ def run_discrepancy(
     if opts.max_effects < 0:
         raise DiscrepancyError(f"--max-effects {opts.max_effects}: must be >= 0")
     say = log or (lambda _msg: None)
-    prep_name, prep_params = None, {}
+    prep_name, prep_params, pca = None, {}, None
     if samples is None:
         if store is None:
             raise DiscrepancyError("run_discrepancy: give a store or a samples frame")
         from suds_exp.preprocess import load_samples
 
-        prep_name, prep_params = _resolve_prep(store, prep)
+        prep_name, prep_params, prep_id = _resolve_prep(store, prep)
         samples = load_samples(store, prep_name, trials)
+        if opts.passive:
+            pca = load_pca(store, prep_id)
     elif trials is not None:
         samples = samples[samples["trial_id"].isin(list(trials))]
     if samples.empty:
@@ -343,7 +376,7 @@ def run_discrepancy(
         )
     rng = np.random.default_rng(opts.seed)
 
-    windows = make_windows(samples, rs)
+    windows = make_windows(samples, rs, pca)
     if len(windows.info) == 0:
         raise DiscrepancyError(
             "every trial is shorter than one replay window "
@@ -356,10 +389,10 @@ def run_discrepancy(
         )
     train, test = windows.subset(train_ids), windows.subset(test_ids)
     coarse_meas = measured(windows)
-    scales = np.sqrt(np.nanmean(coarse_meas**2, axis=(0, 1)))
+    scales = _scales(coarse_meas)
     # the gap itself (and the parameter refinement) is measured without decimation: the
     # decimated replay's own error would otherwise look like a systematic gap
-    full = make_windows(samples[samples["trial_id"].isin(windows.trial_id)], _full_rate(rs))
+    full = make_windows(samples[samples["trial_id"].isin(windows.trial_id)], _full_rate(rs), pca)
     meas_all = measured(full)
     is_test = np.isin(full.trial_id, test_ids)
     phase_all, ra_all, t_all = (window_field(full, f) for f in ("phase", "ra", "t"))
@@ -374,20 +407,20 @@ def run_discrepancy(
     example_k = int(np.flatnonzero(is_test)[0])
     for index in range(opts.max_effects + 1):
         sim = replay(full, [current])[0]
-        residual = sim - meas_all
+        residual = (sim - meas_all)[..., :3]
         _, tl = trial_losses(sim[None, is_test], meas_all[is_test], scales, full.trial_id[is_test])
         step = Step(
             index=index,
             model=current,
             test_loss=float(tl[0].mean()),
-            test_rmse=_rmse(sim[is_test], meas_all[is_test]),
+            test_rmse=_rmse(sim[is_test, :, :3], meas_all[is_test, :, :3]),
             test_trial_loss=tl[0],
             localisation=localise(full.info, residual, phase_all, ra_all, rng),
             example={
                 "trial_id": int(full.trial_id[example_k]),
                 "t": t_all[example_k],
-                "measured": meas_all[example_k],
-                "simulated": sim[example_k],
+                "measured": meas_all[example_k, :, :3],
+                "simulated": sim[example_k, :, :3],
             },
         )
         if steps:
