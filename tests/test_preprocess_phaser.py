@@ -84,3 +84,15 @@ def test_stored_state_reproduces_the_phase(trained):
 def test_constant_channel_is_refused():
     with pytest.raises(PreprocessError, match="constant"):
         Phaser().fit([np.column_stack([np.sin(np.arange(500) / 10), np.ones(500)])])
+
+
+def test_a_channel_going_round_twice_per_cycle_is_left_out():
+    def with_double(n, seed):
+        channels, theta = oscillator(n, seed)
+        return np.column_stack([channels, np.cos(2 * theta)]), theta
+
+    phaser = Phaser().fit([with_double(3000, i)[0] for i in range(3)])
+    assert phaser.channel_ok_.tolist() == [True, True, True, False]
+    assert phaser.weights_[3] == 0
+    channels, theta = with_double(2500, 90)
+    assert phase_rms(phaser.transform(channels), theta) < 0.05

@@ -277,3 +277,23 @@ def test_a_database_without_preprocessing_is_told_what_to_do(tmp_path):
     duckdb.connect(str(db)).close()
     with pytest.raises(PreprocessError, match="no preprocessing tables yet"):
         load_samples(Store(db), 1)
+
+
+def test_other_variants_run_and_keep_the_phase(dataset):
+    from suds_exp.preprocess.truth import truth_errors
+
+    store = Store(dataset)
+    params = {
+        "phaser_channels": "ra+rp",
+        "phaser_group": "all",
+        "joint_fit": "trial",
+        "sg_window_cycles": 0,
+        "k": 2,
+    }
+    result = preprocess(store, params=params, progress=False)
+    fits = store.query_df("SELECT kind, grp FROM prep_fits ORDER BY kind, grp")
+    assert fits.values.tolist() == [["pca", ""], ["phaser", "all"]]  # no shared joints
+    errors = truth_errors(store, result.version_id).set_index("trial_id")
+    # one Phaser for all five gaits still tracks each trial's phase
+    assert errors.loc[-1].err_phase < 0.1
+    assert errors.loc[-1].err_ra < 0.02

@@ -11,7 +11,9 @@ Implemented from the published description:
    S_n = <e^{-i n phi}> over the training data (the protophase-to-phase transform of
    Kralemann et al. 2008, the density form of Phaser's series correction);
 3. the corrected channel phases are aligned by their mean circular offsets and combined
-   with weights given by the first principal component of their unwrapped series;
+   with weights given by the first principal component of their unwrapped series
+   (channels whose protophase does not advance at channel 0's rate, within a factor
+   `MAX_RATE_RATIO`, are left out);
 4. the combined phase gets a final Fourier-series correction of the same kind;
 5. phase zero is a Poincare section: the mean phase at which the first channel crosses
    its mean upwards.
@@ -31,6 +33,9 @@ from scipy.signal import hilbert
 from suds_exp.preprocess.errors import PreprocessError
 
 TWO_PI = 2 * np.pi
+#: Channels whose protophase advances faster or slower than channel 0's by more than this
+#: factor are left out of the combination.
+MAX_RATE_RATIO = 1.25
 
 
 def _wrap(angle):
@@ -110,7 +115,9 @@ class Phaser:
     offsets_ : array of shape (n_channels,), rad
         Circular offset of each corrected channel phase from channel 0.
     weights_ : array of shape (n_channels,)
-        Combination weights (sum 1).
+        Combination weights (sum 1); 0 for a channel left out.
+    channel_ok_ : bool array of shape (n_channels,)
+        Channels whose protophase goes round once per cycle of channel 0 (kept).
     final_series_ : complex array of shape (order,)
     zero_ : float, rad
         Phase of the Poincare section, subtracted so it becomes phase 0.
@@ -169,6 +176,17 @@ class Phaser:
         u = np.concatenate(unwrapped)
         _, vectors = np.linalg.eigh(u.T @ u)
         w = np.abs(vectors[:, -1])
+        # a channel that does not go round once per cycle of channel 0 (a flipper opening
+        # twice per cycle, a channel with no oscillation) carries no usable phase
+        rate = np.array(
+            [
+                np.mean([np.unwrap(p[:, k])[-1] - np.unwrap(p[:, k])[0] for p in proto])
+                for k in range(len(w))
+            ]
+        )
+        ratio = rate / rate[0] if rate[0] > 0 else np.ones_like(rate)
+        self.channel_ok_ = (ratio > 1 / MAX_RATE_RATIO) & (ratio < MAX_RATE_RATIO)
+        w = np.where(self.channel_ok_, w, 0.0)
         self.weights_ = w / w.sum()
         combined = [self._combine(th) for th in thetas]
         self.final_series_ = _series_coefficients(_wrap(np.concatenate(combined)), order)
@@ -207,6 +225,7 @@ class Phaser:
             "n_channels": int(len(self.mean_)),
             "offsets": self.offsets_.tolist(),
             "weights": self.weights_.tolist(),
+            "channel_ok": self.channel_ok_.tolist(),
             "final_series": [[c.real, c.imag] for c in self.final_series_],
             "zero": self.zero_,
         }
@@ -220,6 +239,7 @@ class Phaser:
         p.channel_series_ = (cs[:, 0] + 1j * cs[:, 1]).reshape(state["n_channels"], -1)
         p.offsets_ = np.asarray(state["offsets"])
         p.weights_ = np.asarray(state["weights"])
+        p.channel_ok_ = np.asarray(state["channel_ok"], dtype=bool)
         fs = np.asarray(state["final_series"])
         p.final_series_ = fs[:, 0] + 1j * fs[:, 1]
         p.zero_ = float(state["zero"])
