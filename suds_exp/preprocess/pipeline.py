@@ -3,9 +3,9 @@
 A run resolves its version (same parameters = same version), reads the markers of the
 trials not yet done, cleans them and measures their geometry (any refused trial stops the
 run before anything is written), fits what the version lacks (segment origins, passive
-PCA, one Phaser per trial group) on those trials and stores it, then writes each trial's
-samples with its stats in one transaction. An interrupted run therefore resumes with the
-trials not yet done, reusing the stored fit.
+PCA, one Phaser per trial group) on those trials and stores it, then writes the trials'
+samples with their stats in batches, each batch in one transaction. An interrupted run
+therefore resumes with the trials not yet done, reusing the stored fit.
 """
 
 from __future__ import annotations
@@ -47,7 +47,8 @@ from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 from suds_exp.store.tables import trials
 
-#: Trials whose samples are written in one transaction (resume granularity).
+#: Trials are written in batches of about this many frames, one transaction each (fewer
+#: transactions are faster; a batch is what an interrupted run may have to redo).
 WRITE_BATCH_FRAMES = 50_000
 
 
@@ -281,6 +282,9 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
 
 def _stats_row(tr: _Trial, version_id: int, joints: Joints) -> dict:
     c = tr.clean
+    head, tail = joints.points(tr.measured.frames)
+    # this trial's distance between the segment origins (constant if the fit holds here)
+    dist = np.hypot(*(head - tail).T)
     return {
         "version_id": version_id,
         "trial_id": tr.id,
@@ -290,8 +294,8 @@ def _stats_row(tr: _Trial, version_id: int, joints: Joints) -> dict:
         "filled_fraction": c.filled_fraction,
         "longest_gap_frames": c.longest_gap,
         "plane_normal": tr.measured.plane.basis[2].tolist(),
-        "middle_length_mm": joints.length_mm,
-        "joint_rms_mm": joints.rms_mm,
+        "middle_length_mm": float(dist.mean()),
+        "joint_rms_mm": float(dist.std()),
         "phaser_group": tr.group,
         "done_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
     }
