@@ -448,6 +448,11 @@ def run_discrepancy(
             say(f"  fitted {c.label}: {r.value} in {r.seconds:.1f} s")
         if step.candidates:
             score_candidates(step.candidates, current, test, scales, opts.alpha, opts.fit)
+            _, base_train = trial_losses(
+                replay(train, [current]), measured(train), scales, train.trial_id
+            )
+            for r in step.candidates:
+                r.train_before = float(base_train[0].mean())
         significant = [r for r in step.candidates if r.significant]
         if not significant:
             step.decision = "none_significant"
