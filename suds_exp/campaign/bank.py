@@ -173,7 +173,7 @@ class SampleBank:
 
     def rows(self, i: int, first: int, last: int) -> np.ndarray:
         """``values`` rows of trial index ``i`` whose cycle is in [first, last]."""
-        block = self.values[self.row_start[i] : self.row_stop[i]]
+        block = np.asarray(self.values[self.row_start[i] : self.row_stop[i]])
         cycle = block[:, self.columns.index("cycle")]
         return block[(cycle >= first) & (cycle <= last)]
 

@@ -7,6 +7,7 @@ back plain row dicts for the parent to write.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import time
 from datetime import UTC, datetime
@@ -48,17 +49,30 @@ VB = ("vx", "vy", "wz")
 Chunk = list[tuple[Draw, list[str]]]
 
 
+_PINNED = False
+
+
 def run_chunk(
-    bank: SampleBank, chunk: Chunk, models: dict[str, dict], test_cycles: int
+    bank: SampleBank,
+    chunk: Chunk,
+    models: dict[str, dict],
+    test_cycles: int,
+    blas: str = "block",
 ) -> list[dict]:
     """Rows of every job in ``chunk`` (a list of (draw, learner names)).
 
-    BLAS is limited to one thread so a job computes the same floating-point numbers in
-    the parent, in a loky worker and on a dask worker, and workers do not oversubscribe
-    the cores.
+    BLAS runs on one thread, so a job computes the same floating-point numbers in the
+    parent, in a loky worker and on a dask worker, and workers do not oversubscribe the
+    cores. ``blas``: "block" limits it for this call (~2 ms: threadpoolctl scans the loaded
+    libraries), "pin" once for the life of the process (dedicated loky workers), "none"
+    leaves it to the caller.
     """
+    global _PINNED
     rows: list[dict] = []
-    with threadpool_limits(limits=1):
+    if blas == "pin" and not _PINNED:
+        threadpool_limits(limits=1)
+        _PINNED = True
+    with threadpool_limits(limits=1) if blas == "block" else contextlib.nullcontext():
         for draw, names in chunk:
             rows.extend(run_draw(bank, draw, names, models, test_cycles))
     return rows

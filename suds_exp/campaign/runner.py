@@ -30,6 +30,7 @@ from datetime import UTC, datetime
 
 import pandas as pd
 import sqlalchemy as sa
+from threadpoolctl import threadpool_limits
 
 from suds_exp.campaign import tables
 from suds_exp.campaign.bank import SampleBank, rounded_conditions
@@ -369,7 +370,8 @@ class _Signals:
 def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextlib.ExitStack):
     args = (plan.models, plan.test_cycles)
     if backend == "loky" and jobs == 1:
-        return (run_chunk(bank, c, *args) for c in chunks)
+        stack.enter_context(threadpool_limits(limits=1))
+        return (run_chunk(bank, c, *args, blas="none") for c in chunks)
     from joblib import Parallel, delayed, parallel_config
 
     if backend == "loky":
@@ -400,7 +402,8 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
         shared = bank
         stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
     gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
-        delayed(run_chunk)(shared, c, *args) for c in chunks
+        delayed(run_chunk)(shared, c, *args, blas="pin" if backend == "loky" else "block")
+        for c in chunks
     )
     stack.callback(getattr(gen, "close", lambda: None))
     return gen
