@@ -20,7 +20,6 @@ scattered object (dask) instead of a copy per job.
 from __future__ import annotations
 
 import re
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -147,14 +146,14 @@ class SampleBank:
             decimation=dict(sorted(decimation.items())),
         )
 
-    def memmapped(self, folder: str | Path | None = None) -> SampleBank:
-        """The same bank with ``values`` in a read-only memory-mapped .npy file.
+    def memmapped(self, folder: str | Path) -> SampleBank:
+        """The same bank with ``values`` in a read-only memory-mapped .npy file in
+        ``folder`` (the caller removes it).
 
         joblib's loky backend pickles a file-backed memory map as its file name, so every
         worker maps the same pages instead of receiving a copy per task.
         """
-        folder = Path(folder or tempfile.mkdtemp(prefix="suds_bank_"))
-        path = folder / "bank_values.npy"
+        path = Path(folder) / "bank_values.npy"
         np.save(path, self.values)
         return replace(self, values=np.load(path, mmap_mode="r"))
 

@@ -48,6 +48,7 @@ from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.progress import job_progress
 from suds_exp.campaign.sampling import check_feasible
+from suds_exp.errors import StoreError
 from suds_exp.store import Store
 
 BACKENDS = ("loky", "dask")
@@ -425,14 +426,21 @@ def _execute(
 ) -> None:
     buffer: list[dict] = []
 
-    def flush():
+    def flush(final: bool = False):
         if not buffer:
             return
         t0 = time.perf_counter()
         with signals.shielded():
             frame = pd.DataFrame(buffer, columns=list(RESULT_COLUMNS))
-            with store.write() as conn:
-                store.insert_df(conn, "results", frame)
+            try:
+                with store.write() as conn:
+                    store.insert_df(conn, "results", frame)
+            except StoreError:
+                # Another process held the file longer than the store waits: keep the
+                # rows and try again at the next batch (the last write gives up).
+                if final:
+                    raise
+                return
             summary.done_now += len(frame)
             summary.failed_now += int(frame["error"].notna().sum())
             summary.batches += 1
@@ -462,6 +470,6 @@ def _execute(
             # Rows already received are written even when stopping or failing: a stop
             # loses no finished work. A second Ctrl-C during this write is served after it.
             try:
-                flush()
+                flush(final=True)
             except KeyboardInterrupt:
                 summary.interrupted = True
