@@ -100,13 +100,8 @@ def kill_and_resume(tmp_path, samples_file, n_kills: int) -> None:
     pd.testing.assert_frame_equal(results(Store(db)), expected, check_exact=True)
 
 
-@pytest.mark.slow
 def test_sigkill_at_five_random_moments_loses_nothing_it_wrote(tmp_path, samples_file):
     kill_and_resume(tmp_path, samples_file, n_kills=5)
-
-
-def test_sigkill_at_a_random_moment_loses_nothing_it_wrote(tmp_path, samples_file):
-    kill_and_resume(tmp_path, samples_file, n_kills=1)
 
 
 def test_status_and_sql_answer_and_a_second_run_is_refused_while_a_campaign_runs(

@@ -42,19 +42,6 @@ def test_two_loky_workers_give_the_rows_of_one(tmp_path, samples, reference):
     pd.testing.assert_frame_equal(rows, reference, check_exact=True)
 
 
-def test_dask_backend_gives_the_rows_of_one_worker(tmp_path, samples, reference):
-    distributed = pytest.importorskip("dask.distributed")
-    # in-process cluster (fast); the multi-process cluster is the slow test below
-    with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
-    ) as cluster:
-        rows = run_on(
-            tmp_path, samples, jobs=1, backend="dask", scheduler=cluster.scheduler_address
-        )
-    pd.testing.assert_frame_equal(rows, reference, check_exact=True)
-
-
-@pytest.mark.slow
 def test_a_two_process_dask_local_cluster_gives_the_rows_of_one_worker(
     tmp_path, samples, reference
 ):
