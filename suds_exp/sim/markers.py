@@ -14,21 +14,12 @@ import math
 import numpy as np
 from scipy.signal import cont2discrete, lfilter, ss2tf
 
+from suds_exp.ingest.layout import ROLES
 from suds_exp.sim.config import SimConfig
 
-MARKER_NAMES = (
-    "head_top_1",
-    "head_top_2",
-    "head_spoke",
-    "tail_top_1",
-    "tail_top_2",
-    "tail_spoke",
-    "tail_back",
-    "flipper_1",
-    "flipper_2",
-    "flipper_3",
-    "flipper_4",
-)
+#: The simulated robot carries one marker per role, named after the role, so its files
+#: need no marker layout (the ingest default).
+MARKER_NAMES = ROLES
 
 SPOKE_MARKERS = ("head_spoke", "tail_spoke")
 
