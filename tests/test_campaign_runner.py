@@ -229,11 +229,10 @@ def test_cli_runs_all_five_learners_on_preprocessed_captures(tmp_path, captured)
 
 
 def test_demo_options_pick_a_few_conditions_at_the_extreme_frequencies():
-    samples = synthetic_samples(
-        conditions=(("O", 1 / 3), ("O", 0.5), ("O", 1.0), ("D+", 1 / 3), ("D+", 1.0), ("S-", 1.0))
-    )
-    options = demo_options(samples, prep="v1")
-    assert options.train_conditions == options.test_conditions == "O@0.333333,O@1,D+@0.333333,D+@1"
+    conditions = [(g, f) for g in ("S+", "O", "D-", "D+") for f in (1 / 3, 0.5, 1.0)]
+    options = demo_options(synthetic_samples(conditions=conditions), prep="v1")
+    chosen = "O@0.333333,O@1,D-@0.333333,D-@1,D+@0.333333,D+@1"
+    assert options.train_conditions == options.test_conditions == chosen
     assert list(options.models) == list(LEARNERS) and options.boots == 2
     assert options.train_cycles == 5 and options.sweep == [1, 2]
     short = synthetic_samples(conditions=(("O", 1.0),), trials_per_condition=2, cycles=(4.5, 5))

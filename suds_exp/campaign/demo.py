@@ -11,11 +11,12 @@ from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.runner import RunSummary, _resolve_prep, run_campaign
 from suds_exp.store import Store
 
-#: Gaits the demo prefers, in order: the circle and the two extreme shapes.
-DEMO_GAITS = ("O", "D+", "S+")
+#: Gaits the demo prefers, in order: with them the pairs cover every gait similarity
+#: (same, near = one step on S+ S- O D- D+, far = more).
+DEMO_GAITS = ("O", "D-", "D+")
 
 
-def demo_options(samples: pd.DataFrame, prep: str | None = None, n_conditions: int = 4):
+def demo_options(samples: pd.DataFrame, prep: str | None = None, n_conditions: int = 6):
     """Options of the demo campaign for these samples.
 
     Up to ``n_conditions`` conditions: the preferred gaits at the slowest and fastest
@@ -60,7 +61,7 @@ def demo_campaign(
     progress: bool = True,
 ) -> RunSummary:
     """Run (or finish) the demo campaign on preprocessing version ``prep`` (None: the
-    only one); about 240 jobs, a minute or two on 2 cores. Returns the `RunSummary`."""
+    only one); about 480 jobs, a minute or two on 2 cores. Returns the `RunSummary`."""
     from suds_exp.preprocess import load_samples
 
     prep = _resolve_prep(store, prep)
