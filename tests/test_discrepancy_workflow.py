@@ -15,7 +15,12 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from suds_exp.discrepancy import candidates_for, draw_hidden, hidden_effect_run
+from suds_exp.discrepancy import (
+    candidates_for,
+    demo_discrepancy,
+    draw_hidden,
+    hidden_effect_run,
+)
 from suds_exp.discrepancy.demo import HIDDEN, simulate_measured
 from suds_exp.discrepancy.effects import effect_parameters
 from suds_exp.sim.config import SimConfig
@@ -105,6 +110,15 @@ def test_report_page_is_self_contained(cli_run):
         assert name in page
     assert "http://" not in page and "https://" not in page
     assert (out / "steps.csv").exists() and (out / "candidates.md").exists()
+
+
+def test_demo_reports_the_hidden_effect_and_the_gap(tmp_path):
+    summary = demo_discrepancy("drag_anisotropy", seed=4, out=tmp_path / "rep", **SMALL)
+    (hidden,) = summary["hidden"]
+    assert hidden == "drag_anisotropy"
+    assert summary["named"][0]["effect"] == "drag_anisotropy"
+    assert summary["gap_after"] < summary["gap_before"]
+    assert (tmp_path / "rep" / "index.html").exists()
 
 
 def test_user_errors_exit_2(inertia_db):
