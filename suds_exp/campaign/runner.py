@@ -129,6 +129,10 @@ def finished_keys(store: Store, name: str) -> set[tuple]:
 def pending_chunks(plan: Plan, done: set[tuple], chunk_jobs: int) -> tuple[list[Chunk], int, int]:
     """Chunks of (draw, learners still to run) holding about ``chunk_jobs`` jobs each.
 
+    Draws with the most training cycles come first (longest jobs first), so the last
+    tasks of a run are short and no worker idles long at the end; the order changes no
+    number, since every draw's seed comes from its key.
+
     Returns (chunks, total jobs of the campaign, pending jobs).
     """
     draws = enumerate_draws(
@@ -143,7 +147,7 @@ def pending_chunks(plan: Plan, done: set[tuple], chunk_jobs: int) -> tuple[list[
     chunks: list[Chunk] = []
     current: Chunk = []
     size = pending = 0
-    for d in draws:
+    for d in sorted(draws, key=lambda d: -d.n_cycles):
         todo = [
             m
             for m in names
