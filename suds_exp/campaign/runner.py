@@ -202,8 +202,9 @@ def run_campaign(
         A samples frame (columns of `samples` plus `gait`, `frequency_hz`) to use instead
         of ``load_samples(store, options.prep)``; ``options.prep`` then only labels it.
     jobs : int
-        Worker processes (loky) or, with dask, how many jobs run at once (-1: all
-        workers); 1 runs in this process.
+        loky: worker processes (-1: one per core; 1 runs in this process). dask: every
+        thread of the cluster is used; ``jobs`` only sizes the local cluster started
+        when no ``scheduler`` is given.
     backend : {"loky", "dask"}
     scheduler : str, optional
         dask scheduler address (``tcp://host:8786``); None with dask starts a local
