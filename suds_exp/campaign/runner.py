@@ -257,7 +257,7 @@ def run_campaign(
         done = finished_keys(store, name)
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
-            plan, done, chunk_jobs or _default_chunk(len(done), plan, n_workers)
+            plan, done, chunk_jobs or _default_chunk(plan, n_workers)
         )
         summary = RunSummary(name, total, total - pending, created=stored is None)
         _record_start(store, plan, stored is None, total, backend, n_workers, pending)
@@ -304,7 +304,7 @@ def _n_workers(jobs: int) -> int:
     return jobs
 
 
-def _default_chunk(_done: int, plan: Plan, n_workers: int) -> int:
+def _default_chunk(plan: Plan, n_workers: int) -> int:
     if n_workers <= 1:
         return len(plan.models)
     total = len(plan.train_conditions) * len(plan.test_conditions) * plan.boots * len(plan.models)
