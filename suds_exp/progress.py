@@ -9,15 +9,37 @@ from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
     Progress,
+    ProgressColumn,
     TextColumn,
     TimeElapsedColumn,
     TimeRemainingColumn,
 )
+from rich.text import Text
+
+from suds_exp import console
+
+
+class _RateColumn(ProgressColumn):
+    """Items per second, e.g. ``3.20 jobs/s``."""
+
+    def __init__(self, unit: str):
+        super().__init__()
+        self.unit = unit
+
+    def render(self, task) -> Text:
+        speed = task.finished_speed or task.speed
+        return Text(f"-- {self.unit}/s" if speed is None else f"{speed:.2f} {self.unit}/s")
 
 
 @contextmanager
-def progress_bar(label: str, total: int, enabled: bool = True) -> Iterator[Callable[[int], None]]:
-    """Yield ``advance(n=1)``; draws a bar with rate and ETA on stderr when enabled."""
+def progress_bar(
+    label: str, total: int, enabled: bool = True, done: int = 0, unit: str = "items"
+) -> Iterator[Callable[[int], None]]:
+    """Yield ``advance(n=1)``; draws a bar with rate and time left on stderr when enabled.
+
+    The bar starts at ``done`` of ``total``, so resumed work shows its real state; rate
+    and time left are measured on this run's items only.
+    """
     if not enabled:
         yield lambda n=1: None
         return
@@ -25,9 +47,11 @@ def progress_bar(label: str, total: int, enabled: bool = True) -> Iterator[Calla
         TextColumn("[bold]{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
+        _RateColumn(unit),
         TimeElapsedColumn(),
+        TextColumn("eta"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, transient=False) as bar:
-        task = bar.add_task(label, total=total)
+    with Progress(*columns, console=console.err, transient=False, speed_estimate_period=120) as bar:
+        task = bar.add_task(label, total=total, completed=done)
         yield lambda n=1: bar.advance(task, n)

@@ -5,19 +5,12 @@ from __future__ import annotations
 import pandas as pd
 
 from suds_exp.analysis.errors import AnalysisError
+from suds_exp.campaign.grid import KEY_COLUMNS
 from suds_exp.store import Store
 
 #: Columns of ``results_labelled`` the analyses read (the JSON provenance columns are left
 #: in the database: a 100k-row campaign reads in a fraction of the time without them).
-ANALYSIS_COLUMNS = (
-    "campaign",
-    "model",
-    "train_gait",
-    "train_frequency_hz",
-    "test_gait",
-    "test_frequency_hz",
-    "boot",
-    "n_cycles",
+ANALYSIS_COLUMNS = KEY_COLUMNS + (
     "rmse_vx",
     "rmse_vy",
     "rmse_wz",

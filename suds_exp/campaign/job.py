@@ -16,19 +16,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from suds_exp.campaign.bank import SampleBank
-from suds_exp.campaign.grid import Draw
+from suds_exp.campaign.grid import KEY_COLUMNS, Draw
 from suds_exp.campaign.sampling import draw_sample
 
 #: Columns of the `results` table, in order.
-RESULT_COLUMNS = (
-    "campaign",
-    "model",
-    "train_gait",
-    "train_frequency_hz",
-    "test_gait",
-    "test_frequency_hz",
-    "boot",
-    "n_cycles",
+RESULT_COLUMNS = KEY_COLUMNS + (
     "train_trials",
     "train_ranges",
     "test_trial",

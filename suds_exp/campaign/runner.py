@@ -46,9 +46,9 @@ from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
-from suds_exp.campaign.progress import job_progress
 from suds_exp.campaign.sampling import check_feasible
 from suds_exp.errors import StoreError
+from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 
 BACKENDS = ("loky", "dask")
@@ -456,8 +456,12 @@ def _execute(
 
     with (
         _Signals() as signals,
-        job_progress(
-            f"campaign {plan.name}", summary.total_jobs, summary.done_before, enabled=progress
+        progress_bar(
+            f"campaign {plan.name}",
+            summary.total_jobs,
+            enabled=progress,
+            done=summary.done_before,
+            unit="jobs",
         ) as advance,
     ):
         last = time.monotonic()

@@ -2,6 +2,8 @@
 
 import sqlalchemy as sa
 
+from suds_exp.campaign.grid import KEY_COLUMNS
+
 metadata = sa.MetaData()
 
 campaigns = sa.Table(
@@ -50,14 +52,5 @@ results = sa.Table(
     sa.Column("predict_seconds", sa.Float, nullable=False),
     sa.Column("finished_at", sa.DateTime, nullable=False),
     sa.Column("error", sa.String),
-    sa.UniqueConstraint(
-        "campaign",
-        "model",
-        "train_gait",
-        "train_frequency_hz",
-        "test_gait",
-        "test_frequency_hz",
-        "boot",
-        "n_cycles",
-    ),
+    sa.UniqueConstraint(*KEY_COLUMNS),
 )
