@@ -284,3 +284,22 @@ def test_layout_naming_a_marker_the_trial_lacks_is_refused(db, make_qtm, tmp_pat
     assert "layout.csv" in result.stderr and "'M10' (role flipper_4)" in result.stderr
     assert "other.tsv" in result.stderr
     assert_same_db(before, dump_db(db))
+
+
+def test_manifest_without_a_required_column_is_refused(db, make_qtm, tmp_path):
+    good = make_qtm("good.tsv")
+    manifest = tmp_path / "manifest.csv"
+    manifest.write_text("file,gait,repeat\ngood.tsv,O,1\n")
+    result = cli("ingest", good, "--manifest", manifest, "--db", db)
+    assert result.exit_code == 2
+    assert "manifest.csv: line 1: manifest lacks column(s) frequency_hz" in result.stderr
+    assert dump_db(db) == {}
+
+
+def test_layout_lacking_a_role_is_refused(db, make_qtm, tmp_path):
+    layout = tmp_path / "layout.csv"
+    layout.write_text("role,marker\nhead_top_1,M0\n")
+    result = cli("ingest", make_qtm("a.tsv"), "--layout", layout, "--db", db)
+    assert result.exit_code == 2
+    assert "layout.csv: layout lacks role(s) head_top_2" in result.stderr
+    assert dump_db(db) == {}

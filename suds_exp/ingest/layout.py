@@ -9,9 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import pandas as pd
-
 from suds_exp.errors import IngestError
+from suds_exp.ingest.tables_csv import read_text_table
 
 #: The robot's marker roles (DESIGN.md): top-face, raised (spoke) and lowered markers of
 #: the head and tail segments, and one marker on each flipper (1, 2 head; 3, 4 tail;
@@ -35,15 +34,7 @@ DEFAULT_LAYOUT = {role: role for role in ROLES}
 def read_layout(path: Path) -> dict[str, str]:
     """Role -> marker name from the layout CSV at ``path``; every role must be given."""
     path = Path(path)
-    if not path.is_file():
-        raise IngestError(f"{path}: marker layout file not found")
-    try:
-        table = pd.read_csv(path, dtype=str, keep_default_na=False)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError):
-        raise IngestError(f"{path}: expected a CSV with columns role,marker") from None
-    table.columns = [c.strip() for c in table.columns]
-    if list(table.columns[:2]) != ["role", "marker"]:
-        raise IngestError(f"{path}: line 1: expected columns role,marker")
+    table = read_text_table(path, "marker layout", ("role", "marker"))
     layout: dict[str, str] = {}
     for i, (role, marker) in enumerate(zip(table.role, table.marker, strict=True), start=2):
         role, marker = role.strip(), marker.strip()

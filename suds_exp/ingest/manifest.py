@@ -11,9 +11,8 @@ from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
-import pandas as pd
-
 from suds_exp.errors import IngestError
+from suds_exp.ingest.tables_csv import read_text_table
 
 GAITS = ("S+", "S-", "O", "D-", "D+")
 COLUMNS = ("file", "gait", "frequency_hz", "repeat", "notes")
@@ -40,16 +39,7 @@ def parse_frequency(text: str) -> float:
 def read_manifest(path: Path) -> dict[Path, Condition]:
     """Resolved file path -> `Condition` for every row of the manifest at ``path``."""
     path = Path(path)
-    if not path.is_file():
-        raise IngestError(f"{path}: manifest file not found")
-    try:
-        table = pd.read_csv(path, dtype=str, keep_default_na=False)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError):
-        raise IngestError(f"{path}: expected a CSV with columns {','.join(COLUMNS)}") from None
-    table.columns = [c.strip() for c in table.columns]
-    lacking = [c for c in COLUMNS[:4] if c not in table.columns]
-    if lacking:
-        raise IngestError(f"{path}: line 1: manifest lacks column(s) {', '.join(lacking)}")
+    table = read_text_table(path, "manifest", COLUMNS[:4])
     out: dict[Path, Condition] = {}
     for i, row in enumerate(table.itertuples(index=False), start=2):
         where = f"{path}: line {i}"
