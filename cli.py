@@ -160,7 +160,8 @@ def simulate(
     from suds_exp.sim.commands import parse_freqs, parse_gaits, simulate_command
 
     n = len(parse_gaits(gaits)) * len(parse_freqs(freqs)) * repeats
-    with progress_bar("Simulating", total=n, enabled=not (quiet or json_)) as advance:
+    bar = progress_bar("Simulating", total=n, enabled=not (quiet or json_), unit="trials")
+    with bar as advance:
         summary = simulate_command(
             out,
             config,
@@ -465,7 +466,10 @@ def demo(
     if json_:
         console.print_json(summary.__dict__)
     else:
-        console.out.print(f"open {summary.report} in a browser to see the results")
+        console.out.print(
+            f"open {summary.report} and {summary.discrepancy_report} in a browser "
+            "to see the results"
+        )
 
 
 if __name__ == "__main__":

@@ -1,9 +1,10 @@
 """`suds-exp demo`: the whole pipeline on the built-in simulated robot.
 
-simulate the paper's design (5 gaits x 3 frequencies x 4 repeats) into a temporary
+Simulate the paper's design (5 gaits x 3 frequencies x 4 repeats) into a temporary
 folder -> ingest it -> preprocess -> a small bootstrap campaign with all five learners ->
-its report. Every step is idempotent: a second run finds the data stored, the version
-made and the campaign finished, and only rewrites the report.
+its report -> a discrepancy run on new data with one effect hidden in it. Every step is
+idempotent: a second run finds the data stored, the version made and the campaign
+finished, and only rewrites the reports.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from suds_exp.errors import IngestError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 
@@ -30,7 +32,12 @@ class DemoSummary:
     n_results: int = 0
     report: Path | None = None
     discrepancy: dict = field(default_factory=dict)
+    discrepancy_report: Path | None = None
     seconds: dict[str, float] = field(default_factory=dict)
+
+
+def _fmt(value) -> str:
+    return f"{value:.3g}" if isinstance(value, float) else str(value)
 
 
 def run_demo(
@@ -39,16 +46,19 @@ def run_demo(
     campaign: str = "demo",
     jobs: int = 2,
     seed: int = 0,
+    hidden_effect: str = "body_inertia",
     progress: bool = True,
     say: Callable[[str], None] = print,
 ) -> DemoSummary:
     """Run the demo end to end into ``store``; returns a `DemoSummary`.
 
-    ``report_dir / campaign`` receives the campaign report. ``say`` gets one line per
-    finished step.
+    ``report_dir / campaign`` receives the campaign report and
+    ``report_dir / "discrepancy-demo"`` the discrepancy report of ``hidden_effect``
+    hidden in new simulated data. ``say`` gets one line per finished step.
     """
     from suds_exp.analysis import write_report
     from suds_exp.campaign.demo import demo_campaign
+    from suds_exp.discrepancy.demo import demo_discrepancy
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
     from suds_exp.sim import simulate_dataset
@@ -64,14 +74,22 @@ def run_demo(
         return summary.seconds[step]
 
     with tempfile.TemporaryDirectory(prefix="suds-demo-") as tmp:
-        with progress_bar("Simulating", total=60, enabled=progress) as advance:
+        with progress_bar("Simulating", total=60, enabled=progress, unit="trials") as advance:
             data = simulate_dataset(tmp, seed=seed, progress=lambda done, total: advance())
         summary.simulated_seconds = data.simulated_seconds
         say(
             f"simulated {len(data.tsv_paths)} trials ({data.simulated_seconds / 60:.0f} min of "
             f"robot time) in {lap('simulate'):.0f} s"
         )
-        results = ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=progress)
+        try:
+            results = ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=progress)
+        except IngestError as exc:
+            # e.g. a database holding another dataset (or an older simulator's) at the
+            # same conditions: never overwrite it, say how to run the demo anyway.
+            raise IngestError(
+                f"{exc} -- the demo's simulated trials clash with trials already in "
+                f"{store.path}; run the demo on its own database: suds-exp demo --db demo.duckdb"
+            ) from None
         summary.n_trials = len(results)
         fresh = sum(r.status == "ingested" for r in results)
         stored = len(results) - fresh
@@ -96,4 +114,27 @@ def run_demo(
 
     summary.report = write_report(store, campaign, report_dir / campaign)
     say(f"report written to {summary.report} ({lap('report'):.0f} s)")
+
+    # The hidden-effect data lives in its own temporary database: it re-uses the
+    # conditions of the demo's data with different content, which ingest would refuse.
+    found = demo_discrepancy(effect=hidden_effect, seed=seed, out=report_dir / "discrepancy-demo")
+    summary.discrepancy = found
+    hidden = ", ".join(
+        f"{effect} ({', '.join(f'{p}={_fmt(v)}' for p, v in settings.items())})"
+        for effect, settings in found["hidden"].items()
+    )
+    named = (
+        ", ".join(
+            f"{n['candidate']} = {n['value']:.3g} (95% CI {n['ci'][0]:.3g} to {n['ci'][1]:.3g})"
+            if n.get("ci")
+            else f"{n['candidate']} = {n['value']:.3g}"
+            for n in found["named"]
+        )
+        or "nothing"
+    )
+    say(
+        f"discrepancy: hid {hidden} in new simulated data; the workflow named {named}; "
+        f"held-out RMS error of vx {found['rmse_vx_before']:.2f} -> "
+        f"{found['rmse_vx_after']:.2f} mm/s ({lap('discrepancy'):.0f} s)"
+    )
     return summary

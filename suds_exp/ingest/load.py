@@ -161,7 +161,8 @@ def ingest_paths(
         raise IngestError("nothing to ingest: give capture files, folders or --manifest")
     results = []
     source = str(layout) if layout else "layout"
-    bar = progress_bar("Ingesting", total=len(files), enabled=progress and len(files) > 1)
+    enabled = progress and len(files) > 1
+    bar = progress_bar("Ingesting", total=len(files), enabled=enabled, unit="files")
     with bar as advance, store.writer() as conn:
         for path in files:
             condition = conditions.get(Path(path).resolve())

@@ -396,7 +396,7 @@ def preprocess(
     # pass 1: clean and measure every trial to do; any refusal stops before writing
     items: list[_Trial] = []
     with progress_bar(
-        "Cleaning", total=len(todo_meta), enabled=progress and bool(len(todo_meta))
+        "Cleaning", total=len(todo_meta), enabled=progress and bool(len(todo_meta)), unit="trials"
     ) as advance:
         for meta_row in todo_meta.itertuples(index=False):
             items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params))
@@ -496,7 +496,9 @@ def preprocess(
             )
 
     # pass 2: phase, rates, samples; each batch of trials in one transaction
-    with progress_bar("Preprocessing", total=len(items), enabled=progress) as advance:
+    with progress_bar(
+        "Preprocessing", total=len(items), enabled=progress, unit="trials"
+    ) as advance:
         batch: list[_Trial] = []
         for i, tr in enumerate(items):
             batch.append(tr)

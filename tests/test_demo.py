@@ -1,0 +1,37 @@
+"""`suds-exp demo` end to end: the README's main command (about 1-2 minutes: slow)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from cli import app
+from suds_exp.store import Store
+
+runner = CliRunner()
+
+
+@pytest.mark.slow
+def test_demo_runs_end_to_end_and_is_idempotent(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    first = runner.invoke(app, ["demo", "--json"])
+    assert first.exit_code == 0, first.output
+    summary = json.loads(first.stdout)
+    assert summary["n_trials"] == 60
+    assert summary["n_results"] > 0
+    assert (tmp_path / "reports" / "demo" / "index.html").is_file()
+    assert (tmp_path / "reports" / "discrepancy-demo" / "index.html").is_file()
+    assert [n["effect"] for n in summary["discrepancy"]["named"]][:1] == ["body_inertia"]
+    store = Store(tmp_path / "suds.duckdb")
+    counts = store.query_df(
+        "SELECT (SELECT count(*) FROM trials) AS trials, "
+        "(SELECT count(*) FROM results WHERE rmse_vx IS NOT NULL) AS results"
+    )
+    assert counts.trials[0] == 60 and counts.results[0] == summary["n_results"]
+
+    again = runner.invoke(app, ["demo", "--json"])
+    assert again.exit_code == 0, again.output
+    assert json.loads(again.stdout)["n_results"] == summary["n_results"]
+    assert store.query_df("SELECT count(*) AS n FROM trials").n[0] == 60
