@@ -204,6 +204,10 @@ def test_two_hidden_effects_are_both_named(tmp_path):
     hidden = {"body_inertia": {"tau_s": 0.2}, "drag_anisotropy": {"normal_scale": 1.6}}
     run = hidden_effect_run(hidden, seed=21, workdir=tmp_path, **SWEEP)
     assert set(run.named_effects[:2]) == set(hidden), run.result.outcome
+    # earlier-named effects are re-fitted with the later ones in the model
+    for named in run.result.named:
+        lo, hi = named["ci"]
+        assert lo <= run.truth(named["effect"]) <= hi, named
 
 
 @pytest.mark.slow

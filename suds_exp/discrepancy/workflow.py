@@ -479,6 +479,17 @@ def run_discrepancy(
             f"  named {best.candidate.label} (p_adj {best.p_adjusted:.2g}, "
             f"held-out improvement {best.improvement:.0%})"
         )
+        if opts.refine:
+            # effects named earlier were fitted without this one: re-fit each once with
+            # the others in the model (one pass of coordinate descent), so the reported
+            # values and intervals belong to the final model
+            for earlier in steps[:-1]:
+                r = earlier.accepted
+                if r is None or r.candidate.param is None:
+                    continue
+                refine_candidate(r, current, full.subset(train_ids), scales, opts.fit, rng)
+                current = r.config
+                say(f"  re-fitted {r.candidate.label}: {r.value:.4g} {r.ci}")
 
     last = steps[-1]
     named = [s.accepted.candidate.label for s in steps if s.accepted]
