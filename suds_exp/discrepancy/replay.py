@@ -203,7 +203,14 @@ def make_windows(
         if len(t) < 8:
             continue
         dt_cap = float(np.median(np.diff(t)))
-        freq = float(tr["frequency_hz"].iloc[0])
+        freq = tr["frequency_hz"].iloc[0]
+        if freq is None or not np.isfinite(freq) or freq <= 0:
+            # a capture without a manifest: the gait frequency from its phase
+            ph = tr["phase"].to_numpy(float)
+            freq = (ph[-1] - ph[0]) / (2 * np.pi * max(t[-1] - t[0], 1e-9))
+            if not np.isfinite(freq) or freq <= 0:
+                continue
+        freq = float(freq)
         period_frames = 1.0 / (freq * dt_cap)
         step = max(1, int(round(period_frames / s.samples_per_cycle)))
         sg_s = s.sg_window_cycles / freq if s.sg_window_cycles > 0 else s.sg_window_s
