@@ -38,9 +38,10 @@ def progress_bar(
     """Yield ``advance(n=1)``; draws a bar with rate and time left on stderr when enabled.
 
     The bar starts at ``done`` of ``total``, so resumed work shows its real state; rate
-    and time left are measured on this run's items only.
+    and time left are measured on this run's items only. Nothing is drawn when stderr is
+    not a terminal (scripts, pipes, CI logs); set FORCE_TERMINAL=1 to draw anyway.
     """
-    if not enabled:
+    if not enabled or not console.err.is_terminal:
         yield lambda n=1: None
         return
     columns = (
