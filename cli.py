@@ -141,10 +141,14 @@ SimConfigOption = Annotated[
 def simulate(
     out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
     config: SimConfigOption = None,
-    gaits: Annotated[str | None, typer.Option(help="Comma list, e.g. S+,O [all five].")] = None,
-    freqs: Annotated[str | None, typer.Option(help="Hz, comma list [1/3,1/2,1].")] = None,
+    gaits: Annotated[
+        str | None, typer.Option(help="Comma list, e.g. S+,O (default: all five).")
+    ] = None,
+    freqs: Annotated[str | None, typer.Option(help="Hz, comma list (default: 1/3,1/2,1).")] = None,
     repeats: Annotated[int, typer.Option(help="Trials per condition.")] = 4,
-    cycles: Annotated[str | None, typer.Option(help="Cycles per trial MIN:MAX [10:30].")] = None,
+    cycles: Annotated[
+        str | None, typer.Option(help="Cycles per trial MIN:MAX (default: 10:30).")
+    ] = None,
     seed: Annotated[int, typer.Option(help="Same seed, same files.")] = 0,
     effect: EffectOption = None,
     ingest: Annotated[bool, typer.Option("--ingest", help="Ingest the result into --db.")] = False,
@@ -228,12 +232,14 @@ def effects(
 
 @command()
 def preprocess(
-    name: Annotated[str | None, typer.Option(help="Name of a new version [v<id>].")] = None,
+    name: Annotated[
+        str | None, typer.Option(help="Name of a new version (default: v<id>).")
+    ] = None,
     param: Annotated[
         list[str] | None, typer.Option("--param", help="KEY=VALUE over the defaults; repeatable.")
     ] = None,
     trials_: Annotated[
-        str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 [all].")
+        str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 (default: all).")
     ] = None,
     list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
     db: DbOption = None,
@@ -393,20 +399,26 @@ def report(
 @command()
 def discrepancy(
     model: Annotated[
-        Path | None, typer.Option("--model", help="Starting simulator config [nominal].")
+        Path | None, typer.Option("--model", help="Starting simulator config (default: nominal).")
     ] = None,
     model_effect: Annotated[
         list[str] | None,
         typer.Option("--model-effect", help="NAME=VALUE on the starting model; repeatable."),
     ] = None,
-    trials: Annotated[str | None, typer.Option(help="Comma list of trial ids [all].")] = None,
-    prep: Annotated[str | None, typer.Option(help="Preprocessing version [the only one].")] = None,
+    trials: Annotated[
+        str | None, typer.Option(help="Comma list of trial ids (default: all).")
+    ] = None,
+    prep: Annotated[
+        str | None, typer.Option(help="Preprocessing version (default: the only one).")
+    ] = None,
     alpha: Annotated[float, typer.Option(help="Level of the test naming an effect.")] = 0.01,
     max_effects: Annotated[int, typer.Option(help="Stop after naming this many.")] = 3,
     seed: Annotated[int, typer.Option(help="Seed of the trial split and bootstraps.")] = 0,
-    name: Annotated[str | None, typer.Option(help="Run name [discrepancy-<time>].")] = None,
+    name: Annotated[
+        str | None, typer.Option(help="Run name (default: discrepancy-<time>).")
+    ] = None,
     out: Annotated[
-        Path | None, typer.Option(help="Report folder [reports/discrepancy-NAME].")
+        Path | None, typer.Option(help="Report folder (default: reports/discrepancy-NAME).")
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,

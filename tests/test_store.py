@@ -22,8 +22,10 @@ runner = CliRunner()
 def test_help_lists_the_commands():
     result = runner.invoke(app, ["--help"])
     assert result.exit_code == 0
-    for name in ("init", "ingest", "trials", "sql"):
-        assert name in result.stdout
+    # DESIGN.md's stable command names
+    names = "init ingest trials sql simulate connection effects preprocess run status report"
+    for name in (names + " discrepancy demo").split():
+        assert f" {name} " in result.stdout, name
 
 
 def test_init_creates_then_reports_up_to_date(db):
