@@ -117,8 +117,10 @@ def run_demo(
 
     # The hidden-effect data lives in its own temporary database: it re-uses the
     # conditions of the demo's data with different content, which ingest would refuse.
-    found = demo_discrepancy(effect=hidden_effect, seed=seed, out=report_dir / "discrepancy-demo")
+    out = report_dir / "discrepancy-demo"
+    found = demo_discrepancy(effect=hidden_effect, seed=seed, out=out)
     summary.discrepancy = found
+    summary.discrepancy_report = out / "index.html"
     hidden = ", ".join(
         f"{effect} ({', '.join(f'{p}={_fmt(v)}' for p, v in settings.items())})"
         for effect, settings in found["hidden"].items()

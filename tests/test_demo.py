@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -23,6 +24,7 @@ def test_demo_runs_end_to_end_and_is_idempotent(tmp_path, monkeypatch):
     assert summary["n_results"] > 0
     assert (tmp_path / "reports" / "demo" / "index.html").is_file()
     assert (tmp_path / "reports" / "discrepancy-demo" / "index.html").is_file()
+    assert summary["discrepancy_report"] == str(Path("reports/discrepancy-demo/index.html"))
     assert [n["effect"] for n in summary["discrepancy"]["named"]][:1] == ["body_inertia"]
     store = Store(tmp_path / "suds.duckdb")
     counts = store.query_df(
@@ -31,7 +33,9 @@ def test_demo_runs_end_to_end_and_is_idempotent(tmp_path, monkeypatch):
     )
     assert counts.trials[0] == 60 and counts.results[0] == summary["n_results"]
 
-    again = runner.invoke(app, ["demo", "--json"])
+    again = runner.invoke(app, ["demo"])
     assert again.exit_code == 0, again.output
-    assert json.loads(again.stdout)["n_results"] == summary["n_results"]
+    assert "ingested 0 new trials (60 already stored)" in again.stdout
+    assert "reports/demo/index.html and reports/discrepancy-demo/index.html" in again.stdout
     assert store.query_df("SELECT count(*) AS n FROM trials").n[0] == 60
+    assert store.query_df("SELECT count(*) AS n FROM results").n[0] == summary["n_results"]
