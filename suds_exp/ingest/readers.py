@@ -13,21 +13,19 @@ from suds_exp.ingest.csv_reader import read_marker_csv
 from suds_exp.ingest.qtm import read_qtm_tsv
 
 
-def _text(path: Path, data: bytes) -> str:
+def _text(data: bytes) -> str:
+    """Text of a capture file: UTF-8 (with or without BOM), else Latin-1 (QTM on Windows)."""
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:
-        try:
-            return data.decode("latin-1")
-        except UnicodeDecodeError:  # pragma: no cover - latin-1 decodes any byte
-            raise IngestError(f"{path}: expected a text file") from None
+        return data.decode("latin-1")
 
 
 #: extension -> (format name, reader of the file's bytes)
 READERS: dict[str, tuple[str, Callable[[Path, bytes], Capture]]] = {
-    ".tsv": ("qtm-tsv", lambda p, b: read_qtm_tsv(p, _text(p, b))),
+    ".tsv": ("qtm-tsv", lambda p, b: read_qtm_tsv(p, _text(b))),
     ".c3d": ("c3d", read_c3d),
-    ".csv": ("csv", lambda p, b: read_marker_csv(p, _text(p, b))),
+    ".csv": ("csv", lambda p, b: read_marker_csv(p, _text(b))),
 }
 
 
