@@ -121,3 +121,27 @@ def test_savitzky_golay_derivative_is_exact_for_cubics():
     assert window_frames(0.2, 100, 3, 1000) == 21  # odd
     assert window_frames(1.0, 100, 3, 51) == 51  # no longer than the record
     assert window_frames(0.0, 100, 3, 51) == 1  # off
+
+
+def test_rigid_tail_fit_keeps_the_frame_and_averages_the_noise_down():
+    from suds_exp.preprocess.body_frame import rigid_fit
+
+    clean = synthetic_trial("D+", 1.0, n_cycles=4, noise_mm=0.0, seed=3)
+    noisy = synthetic_trial("D+", 1.0, n_cycles=4, noise_mm=0.2, seed=3)
+    exact, top, fitted = measure(clean.xyz), measure(noisy.xyz, "top"), measure(noisy.xyz)
+    # noise-free: the rigid fit reproduces the two-marker frame
+    ref = measure(clean.xyz, "top").frames
+    np.testing.assert_allclose(exact.frames.tail_origin, ref.tail_origin, atol=1e-6)
+    np.testing.assert_allclose(exact.frames.tail_angle, ref.tail_angle, atol=1e-9)
+    np.testing.assert_array_equal(fitted.frames.head_angle, top.frames.head_angle)
+    # noisy: three markers give a less noisy tail angle than two
+    err_top = np.std(top.frames.tail_angle - ref.tail_angle)
+    err_fit = np.std(fitted.frames.tail_angle - ref.tail_angle)
+    assert err_fit < 0.8 * err_top
+    # a single frame: origin and angle of a rotated, shifted template are recovered
+    pts = np.array([[[0.0, 0.0], [10.0, 0.0], [0.0, 5.0]]])
+    o, a = rigid_fit(pts, np.zeros((1, 2)), np.zeros(1))
+    np.testing.assert_allclose(o, [[0.0, 0.0]], atol=1e-12)
+    np.testing.assert_allclose(a, [0.0], atol=1e-12)
+    with pytest.raises(ValueError, match="tail_fit"):
+        measure(clean.xyz, "spokes")

@@ -7,8 +7,11 @@ Following the paper's "Data Processing":
   smallest principal axis of the pooled, per-marker-centred positions), with the mean
   height of the four top-surface markers at Z = 0;
 - each outer segment gets a 2D frame from its two top-surface markers projected on that
-  plane; the segment origins are the points fixed in those frames whose distance to each
-  other stays constant (the motor axes, joined rigidly by the middle segment). They are
+  plane; the tail's frame can then be refined by a per-frame least-squares rigid fit of
+  all its rigid markers (`rigid_fit`: the two top markers and ``tail_back``), whose
+  positions in the two-marker frame are learned as their trial means. The segment
+  origins are the points fixed in those frames whose distance to each other stays
+  constant (the motor axes, joined rigidly by the middle segment). They are
   found by linear least squares on the squared-distance condition, refined by nonlinear
   least squares on the distance itself;
 - the body origin is the midpoint of the two segment origins, +X from the tail origin to
@@ -104,6 +107,36 @@ def segment_frames(head_top: np.ndarray, tail_top: np.ndarray) -> SegmentFrames:
     ho, ha = frame(head_top)
     to, ta = frame(tail_top)
     return SegmentFrames(ho, ha, to, ta)
+
+
+def rigid_fit(
+    points: np.ndarray, origin: np.ndarray, angle: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame least-squares rigid fit of a segment's rigid markers, in its own frame.
+
+    ``points`` (n_frames, n_markers, 2) mm in the plane, markers fixed on one segment;
+    ``origin`` (n_frames, 2) mm and ``angle`` (n_frames,) rad: a first estimate of the
+    segment frame (e.g. from two of the markers). The markers' positions in that frame
+    are learned as their means over the frames; each frame's origin and angle are then
+    the 2D rigid transform that best maps those positions onto the measured ones (equal
+    weights, closed form). With more than two markers this averages the markers' noise
+    down; the frame keeps the first estimate's convention, so the angle stays unwrapped
+    alongside ``angle``. Returns (origin (n_frames, 2) mm, angle (n_frames,) rad).
+    """
+    rel = points - origin[:, None, :]
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    template = np.stack(  # rel rotated by -angle, averaged over frames: (n_markers, 2)
+        [c * rel[..., 0] + s * rel[..., 1], -s * rel[..., 0] + c * rel[..., 1]], axis=-1
+    ).mean(axis=0)
+    t_c = template.mean(axis=0)
+    q = template - t_c
+    p_c = points.mean(axis=1)
+    p = points - p_c[:, None, :]
+    sxx = (q[:, 0] * p[..., 0] + q[:, 1] * p[..., 1]).sum(axis=1)
+    sxy = (q[:, 0] * p[..., 1] - q[:, 1] * p[..., 0]).sum(axis=1)
+    fitted = np.arctan2(sxy, sxx)
+    fitted = angle + np.angle(np.exp(1j * (fitted - angle)))
+    return p_c - _rot(fitted, t_c), fitted
 
 
 def _rot(angle: np.ndarray, v: np.ndarray) -> np.ndarray:

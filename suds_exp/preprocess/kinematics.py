@@ -14,8 +14,10 @@ from suds_exp.preprocess.body_frame import (
     SegmentFrames,
     body_pose,
     fit_plane,
+    rigid_fit,
     segment_frames,
 )
+from suds_exp.preprocess.params import TAIL_FITS
 from suds_exp.preprocess.shape import PASSIVE_ROLES, actuated_shape, passive_state
 
 _ROLE = {role: i for i, role in enumerate(ROLES)}
@@ -34,8 +36,17 @@ class Measured:
     frames: SegmentFrames
 
 
-def measure(xyz: np.ndarray) -> Measured:
-    """Plane and segment frames from cleaned tracks (n_frames, 11, 3) mm in `ROLES` order."""
+#: Tail markers of the rigid tail fit (``tail_fit="rigid"``); the head has only its two
+#: top markers (its spoke rings on its skewer).
+TAIL_RIGID = ("tail_top_1", "tail_top_2", "tail_back")
+
+
+def measure(xyz: np.ndarray, tail_fit: str = "rigid") -> Measured:
+    """Plane and segment frames from cleaned tracks (n_frames, 11, 3) mm in `ROLES` order.
+
+    ``tail_fit``: ``"top"`` takes the tail frame from its two top markers, like the head;
+    ``"rigid"`` refines it by a per-frame rigid fit of `TAIL_RIGID` (`rigid_fit`).
+    """
     xyz = np.asarray(xyz, dtype=float)
     top = xyz[:, [_ROLE[r] for r in TOP]]
     plane = fit_plane(xyz[:, [_ROLE[r] for r in RIGID]], top)
@@ -44,6 +55,13 @@ def measure(xyz: np.ndarray) -> Measured:
         local[:, [_ROLE["head_top_1"], _ROLE["head_top_2"]]],
         local[:, [_ROLE["tail_top_1"], _ROLE["tail_top_2"]]],
     )
+    if tail_fit == "rigid":
+        origin, angle = rigid_fit(
+            local[:, [_ROLE[r] for r in TAIL_RIGID]], frames.tail_origin, frames.tail_angle
+        )
+        frames = SegmentFrames(frames.head_origin, frames.head_angle, origin, angle)
+    elif tail_fit != "top":
+        raise ValueError(f"tail_fit={tail_fit!r}: expected one of {', '.join(TAIL_FITS)}")
     return Measured(plane, local, frames)
 
 

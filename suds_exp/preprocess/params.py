@@ -21,6 +21,9 @@ DEFAULTS: dict[str, Any] = {
     "max_gap_s": 0.25,  # refuse a trial whose longest gap to fill exceeds this, s
     # body frame
     "joint_fit": "version",  # segment origins fitted over all trials of the version | per trial
+    # tail frame: rigid = per-frame least-squares fit of tail_top_1, tail_top_2, tail_back
+    # (less noise in the body pose and velocity) | top = its two top markers only
+    "tail_fit": "rigid",
     # shape
     "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
     "shape_polyorder": 5,  # its polynomial order
@@ -39,6 +42,7 @@ DEFAULTS: dict[str, Any] = {
 }
 
 JOINT_FITS = ("version", "trial")
+TAIL_FITS = ("rigid", "top")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
 MAX_K = 12
@@ -81,6 +85,7 @@ def _check(params: dict[str, Any]) -> None:
             raise ConfigError(f"--param {key}={params[key]}: must be 1..6")
     for key, choices in (
         ("joint_fit", JOINT_FITS),
+        ("tail_fit", TAIL_FITS),
         ("phaser_group", PHASER_GROUPS),
         ("phaser_channels", PHASER_CHANNELS),
     ):
