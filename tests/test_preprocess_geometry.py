@@ -145,3 +145,28 @@ def test_rigid_tail_fit_keeps_the_frame_and_averages_the_noise_down():
     np.testing.assert_allclose(a, [0.0], atol=1e-12)
     with pytest.raises(ValueError, match="tail_fit"):
         measure(clean.xyz, "spokes")
+
+
+def test_differentiator_window_grows_as_a_power_of_the_gait_period():
+    from suds_exp.preprocess.params import DEFAULTS, resolve_params
+    from suds_exp.preprocess.rates import differentiator_window
+
+    # the defaults: 27, 21 and 13 frames at 1/3, 1/2 and 1 Hz
+    assert [differentiator_window(DEFAULTS, 100, f, 4000) for f in (1 / 3, 0.5, 1.0)] == [
+        27,
+        21,
+        13,
+    ]
+    # exponent 1: a fixed number of cycles (and the rule of versions made without it)
+    fixed = resolve_params({"sg_window_cycles": 0.1, "sg_window_exponent": 1})
+    old = {k: v for k, v in fixed.items() if k != "sg_window_exponent"}
+    for params in (fixed, old):
+        assert [differentiator_window(params, 100, f, 4000) for f in (1 / 3, 0.5, 1.0)] == [
+            31,
+            21,
+            11,
+        ]
+    # no frequency: seconds
+    assert differentiator_window(DEFAULTS, 100, None, 4000) == 21
+    with pytest.raises(Exception, match="sg_window_exponent"):
+        resolve_params({"sg_window_exponent": -1})
