@@ -128,7 +128,8 @@ def test_rigid_tail_fit_keeps_the_frame_and_averages_the_noise_down():
 
     clean = synthetic_trial("D+", 1.0, n_cycles=4, noise_mm=0.0, seed=3)
     noisy = synthetic_trial("D+", 1.0, n_cycles=4, noise_mm=0.2, seed=3)
-    exact, top, fitted = measure(clean.xyz), measure(noisy.xyz, "top"), measure(noisy.xyz)
+    exact, top = measure(clean.xyz, "rigid"), measure(noisy.xyz, "top")
+    fitted, hinged = measure(noisy.xyz, "rigid"), measure(noisy.xyz, "rigid+flippers")
     # noise-free: the rigid fit reproduces the two-marker frame
     ref = measure(clean.xyz, "top").frames
     np.testing.assert_allclose(exact.frames.tail_origin, ref.tail_origin, atol=1e-6)
@@ -138,6 +139,18 @@ def test_rigid_tail_fit_keeps_the_frame_and_averages_the_noise_down():
     err_top = np.std(top.frames.tail_angle - ref.tail_angle)
     err_fit = np.std(fitted.frames.tail_angle - ref.tail_angle)
     assert err_fit < 0.8 * err_top
+    # the flippers' circles about their hinges constrain the frame further
+    np.testing.assert_allclose(measure(clean.xyz).frames.tail_angle, ref.tail_angle, atol=1e-9)
+    err_hinged = np.std(hinged.frames.tail_angle - ref.tail_angle)
+    assert err_hinged < 0.9 * err_fit
+    # a hinged marker that does not move (a flipper on its stop) defines no circle: left out
+    from suds_exp.preprocess.body_frame import hinged_fit
+
+    rigid = np.tile([[0.0, 0.0], [10.0, 0.0]], (50, 1, 1))
+    still = np.tile([[[5.0, 5.0]]], (50, 1, 1))
+    o, a = hinged_fit(rigid, still, np.zeros((50, 2)), np.zeros(50))
+    np.testing.assert_array_equal(o, 0.0)
+    np.testing.assert_array_equal(a, 0.0)
     # a single frame: origin and angle of a rotated, shifted template are recovered
     pts = np.array([[[0.0, 0.0], [10.0, 0.0], [0.0, 5.0]]])
     o, a = rigid_fit(pts, np.zeros((1, 2)), np.zeros(1))

@@ -22,8 +22,9 @@ DEFAULTS: dict[str, Any] = {
     # body frame
     "joint_fit": "version",  # segment origins fitted over all trials of the version | per trial
     # tail frame: rigid = per-frame least-squares fit of tail_top_1, tail_top_2, tail_back
-    # (less noise in the body pose and velocity) | top = its two top markers only
-    "tail_fit": "rigid",
+    # (less noise in the body pose and velocity); rigid+flippers = that, plus the tail
+    # flipper markers staying on their circles about the hinges | top = its two top markers
+    "tail_fit": "rigid+flippers",
     # shape
     "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
     "shape_polyorder": 5,  # its polynomial order
@@ -45,7 +46,7 @@ DEFAULTS: dict[str, Any] = {
 }
 
 JOINT_FITS = ("version", "trial")
-TAIL_FITS = ("rigid", "top")
+TAIL_FITS = ("rigid+flippers", "rigid", "top")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
 MAX_K = 12
