@@ -121,3 +121,65 @@ def test_savitzky_golay_derivative_is_exact_for_cubics():
     assert window_frames(0.2, 100, 3, 1000) == 21  # odd
     assert window_frames(1.0, 100, 3, 51) == 51  # no longer than the record
     assert window_frames(0.0, 100, 3, 51) == 1  # off
+
+
+def test_rigid_tail_fit_keeps_the_frame_and_averages_the_noise_down():
+    from suds_exp.preprocess.body_frame import rigid_fit
+
+    clean = synthetic_trial("D+", 1.0, n_cycles=4, noise_mm=0.0, seed=3)
+    noisy = synthetic_trial("D+", 1.0, n_cycles=4, noise_mm=0.2, seed=3)
+    exact, top = measure(clean.xyz, "rigid"), measure(noisy.xyz, "top")
+    fitted, hinged = measure(noisy.xyz, "rigid"), measure(noisy.xyz, "rigid+flippers")
+    # noise-free: the rigid fit reproduces the two-marker frame
+    ref = measure(clean.xyz, "top").frames
+    np.testing.assert_allclose(exact.frames.tail_origin, ref.tail_origin, atol=1e-6)
+    np.testing.assert_allclose(exact.frames.tail_angle, ref.tail_angle, atol=1e-9)
+    np.testing.assert_array_equal(fitted.frames.head_angle, top.frames.head_angle)
+    # noisy: three markers give a less noisy tail angle than two
+    err_top = np.std(top.frames.tail_angle - ref.tail_angle)
+    err_fit = np.std(fitted.frames.tail_angle - ref.tail_angle)
+    assert err_fit < 0.8 * err_top
+    # the flippers' circles about their hinges constrain the frame further
+    np.testing.assert_allclose(measure(clean.xyz).frames.tail_angle, ref.tail_angle, atol=1e-9)
+    err_hinged = np.std(hinged.frames.tail_angle - ref.tail_angle)
+    assert err_hinged < 0.9 * err_fit
+    # a hinged marker that does not move (a flipper on its stop) defines no circle: left out
+    from suds_exp.preprocess.body_frame import hinged_fit
+
+    rigid = np.tile([[0.0, 0.0], [10.0, 0.0]], (50, 1, 1))
+    still = np.tile([[[5.0, 5.0]]], (50, 1, 1))
+    o, a = hinged_fit(rigid, still, np.zeros((50, 2)), np.zeros(50))
+    np.testing.assert_array_equal(o, 0.0)
+    np.testing.assert_array_equal(a, 0.0)
+    # a single frame: origin and angle of a rotated, shifted template are recovered
+    pts = np.array([[[0.0, 0.0], [10.0, 0.0], [0.0, 5.0]]])
+    o, a = rigid_fit(pts, np.zeros((1, 2)), np.zeros(1))
+    np.testing.assert_allclose(o, [[0.0, 0.0]], atol=1e-12)
+    np.testing.assert_allclose(a, [0.0], atol=1e-12)
+    with pytest.raises(ValueError, match="tail_fit"):
+        measure(clean.xyz, "spokes")
+
+
+def test_differentiator_window_grows_as_a_power_of_the_gait_period():
+    from suds_exp.preprocess.params import DEFAULTS, resolve_params
+    from suds_exp.preprocess.rates import differentiator_window
+
+    # the defaults: 27, 21 and 13 frames at 1/3, 1/2 and 1 Hz
+    assert [differentiator_window(DEFAULTS, 100, f, 4000) for f in (1 / 3, 0.5, 1.0)] == [
+        27,
+        21,
+        13,
+    ]
+    # exponent 1: a fixed number of cycles (and the rule of versions made without it)
+    fixed = resolve_params({"sg_window_cycles": 0.1, "sg_window_exponent": 1})
+    old = {k: v for k, v in fixed.items() if k != "sg_window_exponent"}
+    for params in (fixed, old):
+        assert [differentiator_window(params, 100, f, 4000) for f in (1 / 3, 0.5, 1.0)] == [
+            31,
+            21,
+            11,
+        ]
+    # no frequency: seconds
+    assert differentiator_window(DEFAULTS, 100, None, 4000) == 21
+    with pytest.raises(Exception, match="sg_window_exponent"):
+        resolve_params({"sg_window_exponent": -1})

@@ -55,9 +55,10 @@ class ReplaySettings:
         Replayed but not scored before each window, gait cycles.
     samples_per_cycle : int
         Simulator steps per gait cycle (the decimation; 100 Hz capture at 1 Hz is 100).
-    sg_window_s, sg_window_cycles, sg_polyorder : float, float, int
-        The preprocessing version's Savitzky-Golay differentiator: window in s, or in
-        gait cycles when ``sg_window_cycles`` > 0, and its order.
+    sg_window_s, sg_window_cycles, sg_window_exponent, sg_polyorder : float, float, float, int
+        The preprocessing version's Savitzky-Golay differentiator: window in s, or
+        ``sg_window_cycles * T**sg_window_exponent`` s (T the gait period, s) when
+        ``sg_window_cycles`` > 0, and its order.
     solver_tol : float
         Scaled residual tolerance of the simulator's per-step solve during replay.
     ra_smooth_s : float
@@ -75,6 +76,7 @@ class ReplaySettings:
     samples_per_cycle: int = 40
     sg_window_s: float = 0.21
     sg_window_cycles: float = 0.0
+    sg_window_exponent: float = 1.0
     sg_polyorder: int = 3
     solver_tol: float = 1e-7
     ra_smooth_s: float = 0.0
@@ -167,6 +169,7 @@ def settings_from_prep(params: dict, **overrides) -> ReplaySettings:
     return ReplaySettings(
         sg_window_s=float(params.get("sg_window_s", 0.21)),
         sg_window_cycles=float(params.get("sg_window_cycles", 0.0)),
+        sg_window_exponent=float(params.get("sg_window_exponent", 1.0)),
         sg_polyorder=int(params.get("sg_polyorder", 3)),
         shape_window_s=float(params.get("shape_window_s", 0.21)),
         shape_polyorder=int(params.get("shape_polyorder", 5)),
@@ -213,7 +216,11 @@ def make_windows(
         freq = float(freq)
         period_frames = 1.0 / (freq * dt_cap)
         step = max(1, int(round(period_frames / s.samples_per_cycle)))
-        sg_s = s.sg_window_cycles / freq if s.sg_window_cycles > 0 else s.sg_window_s
+        sg_s = (
+            s.sg_window_cycles * (1.0 / freq) ** s.sg_window_exponent
+            if s.sg_window_cycles > 0
+            else s.sg_window_s
+        )
         sg = _odd_window(sg_s, dt_cap, s.sg_polyorder)
         half = sg // 2
         n_warm = int(round(s.warmup_cycles * period_frames / step)) * step

@@ -7,8 +7,11 @@ Following the paper's "Data Processing":
   smallest principal axis of the pooled, per-marker-centred positions), with the mean
   height of the four top-surface markers at Z = 0;
 - each outer segment gets a 2D frame from its two top-surface markers projected on that
-  plane; the segment origins are the points fixed in those frames whose distance to each
-  other stays constant (the motor axes, joined rigidly by the middle segment). They are
+  plane; the tail's frame can then be refined by a per-frame least-squares rigid fit of
+  all its rigid markers (`rigid_fit`: the two top markers and ``tail_back``), whose
+  positions in the two-marker frame are learned as their trial means. The segment
+  origins are the points fixed in those frames whose distance to each other stays
+  constant (the motor axes, joined rigidly by the middle segment). They are
   found by linear least squares on the squared-distance condition, refined by nonlinear
   least squares on the distance itself;
 - the body origin is the midpoint of the two segment origins, +X from the tail origin to
@@ -104,6 +107,125 @@ def segment_frames(head_top: np.ndarray, tail_top: np.ndarray) -> SegmentFrames:
     ho, ha = frame(head_top)
     to, ta = frame(tail_top)
     return SegmentFrames(ho, ha, to, ta)
+
+
+def rigid_fit(
+    points: np.ndarray, origin: np.ndarray, angle: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame least-squares rigid fit of a segment's rigid markers, in its own frame.
+
+    ``points`` (n_frames, n_markers, 2) mm in the plane, markers fixed on one segment;
+    ``origin`` (n_frames, 2) mm and ``angle`` (n_frames,) rad: a first estimate of the
+    segment frame (e.g. from two of the markers). The markers' positions in that frame
+    are learned as their means over the frames; each frame's origin and angle are then
+    the 2D rigid transform that best maps those positions onto the measured ones (equal
+    weights, closed form). With more than two markers this averages the markers' noise
+    down; the frame keeps the first estimate's convention, so the angle stays unwrapped
+    alongside ``angle``. Returns (origin (n_frames, 2) mm, angle (n_frames,) rad).
+    """
+    rel = points - origin[:, None, :]
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    template = np.stack(  # rel rotated by -angle, averaged over frames: (n_markers, 2)
+        [c * rel[..., 0] + s * rel[..., 1], -s * rel[..., 0] + c * rel[..., 1]], axis=-1
+    ).mean(axis=0)
+    t_c = template.mean(axis=0)
+    q = template - t_c
+    p_c = points.mean(axis=1)
+    p = points - p_c[:, None, :]
+    sxx = (q[:, 0] * p[..., 0] + q[:, 1] * p[..., 1]).sum(axis=1)
+    sxy = (q[:, 0] * p[..., 1] - q[:, 1] * p[..., 0]).sum(axis=1)
+    fitted = np.arctan2(sxy, sxx)
+    fitted = angle + np.angle(np.exp(1j * (fitted - angle)))
+    return p_c - _rot(fitted, t_c), fitted
+
+
+#: A hinged marker constrains its segment's frame only if its circle is well determined:
+#: points spread over at least this arc (5th to 95th percentile), rad ...
+HINGE_MIN_ARC_RAD = 0.3
+#: ... and lying within this RMS distance of the fitted circle, mm.
+HINGE_MAX_RMS_MM = 1.0
+
+
+def _to_frame(points: np.ndarray, origin: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Plane points (n, m, 2) into per-frame 2D frames (origin (n, 2), angle (n,))."""
+    rel = points - origin[:, None, :]
+    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return np.stack([c * rel[..., 0] + s * rel[..., 1], -s * rel[..., 0] + c * rel[..., 1]], -1)
+
+
+def _circle(u: np.ndarray) -> tuple[np.ndarray, float, float, float]:
+    """Algebraic least-squares circle through points (n, 2): centre, radius, RMS radial
+    residual and the arc the points span (5th to 95th percentile of their angle)."""
+    design = np.column_stack([2 * u, np.ones(len(u))])
+    sol, *_ = np.linalg.lstsq(design, (u**2).sum(axis=1), rcond=None)
+    centre = sol[:2]
+    radius = float(np.sqrt(max(sol[2] + centre @ centre, 0.0)))
+    d = u - centre
+    rms = float(np.sqrt(np.mean((np.hypot(d[:, 0], d[:, 1]) - radius) ** 2)))
+    ang = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    arc = float(np.percentile(ang, 95) - np.percentile(ang, 5))
+    return centre, radius, rms, arc
+
+
+def hinged_fit(
+    rigid: np.ndarray,
+    hinged: np.ndarray,
+    origin: np.ndarray,
+    angle: np.ndarray,
+    iterations: int = 3,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame least-squares fit of a segment frame to its rigid and hinged markers.
+
+    ``rigid`` (n_frames, m, 2) mm: markers fixed on the segment; ``hinged`` (n_frames, h, 2)
+    mm: markers on parts hinged to it (flippers), each moving on a circle fixed in the
+    segment frame; ``origin`` (n_frames, 2) mm and ``angle`` (n_frames,) rad: a first
+    estimate of the frame (e.g. `rigid_fit`). The rigid markers' positions and each hinged
+    marker's circle (algebraic fit) are learned in that frame over the trial; a hinged
+    marker whose circle is poorly determined (its points span less than
+    `HINGE_MIN_ARC_RAD`, e.g. a flipper resting on its stop, or lie further than
+    `HINGE_MAX_RMS_MM` from it) is left out. Each frame then minimises the squared
+    rigid-marker misfits plus the squared distances of the hinged markers from their
+    circles (one equation each: the flipper angle stays free), by Gauss-Newton from the
+    first estimate (forward-difference Jacobian). Returns (origin (n_frames, 2) mm,
+    angle (n_frames,) rad).
+    """
+    template = _to_frame(rigid, origin, angle).mean(axis=0)
+    local = _to_frame(hinged, origin, angle)
+    circles = []
+    for k in range(hinged.shape[1]):
+        centre, radius, rms, arc = _circle(local[:, k])
+        if arc >= HINGE_MIN_ARC_RAD and rms <= HINGE_MAX_RMS_MM:
+            circles.append((k, centre, radius))
+    if not circles:
+        return origin, angle
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        o, a = x[:, :2], x[:, 2]
+        c, s = np.cos(a)[:, None], np.sin(a)[:, None]
+        placed = np.stack(
+            [c * template[:, 0] - s * template[:, 1], s * template[:, 0] + c * template[:, 1]],
+            axis=-1,
+        )
+        out = [(o[:, None, :] + placed - rigid).reshape(len(x), -1)]
+        u = _to_frame(hinged[:, [k for k, _, _ in circles]], o, a)
+        for j, (_, centre, radius) in enumerate(circles):
+            d = u[:, j] - centre
+            out.append((np.hypot(d[:, 0], d[:, 1]) - radius)[:, None])
+        return np.concatenate(out, axis=1)
+
+    x = np.column_stack([origin, angle])
+    steps = (1e-4, 1e-4, 1e-6)  # mm, mm, rad
+    for _ in range(iterations):
+        r0 = residuals(x)
+        jac = np.empty((*r0.shape, 3))
+        for j, h in enumerate(steps):
+            dx = np.zeros(3)
+            dx[j] = h
+            jac[..., j] = (residuals(x + dx) - r0) / h
+        hess = np.einsum("nij,nik->njk", jac, jac)
+        grad = np.einsum("nij,ni->nj", jac, r0)
+        x = x - np.linalg.solve(hess, grad[..., None])[..., 0]
+    return x[:, :2], x[:, 2]
 
 
 def _rot(angle: np.ndarray, v: np.ndarray) -> np.ndarray:

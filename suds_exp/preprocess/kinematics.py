@@ -14,8 +14,11 @@ from suds_exp.preprocess.body_frame import (
     SegmentFrames,
     body_pose,
     fit_plane,
+    hinged_fit,
+    rigid_fit,
     segment_frames,
 )
+from suds_exp.preprocess.params import TAIL_FITS
 from suds_exp.preprocess.shape import PASSIVE_ROLES, actuated_shape, passive_state
 
 _ROLE = {role: i for i, role in enumerate(ROLES)}
@@ -34,8 +37,23 @@ class Measured:
     frames: SegmentFrames
 
 
-def measure(xyz: np.ndarray) -> Measured:
-    """Plane and segment frames from cleaned tracks (n_frames, 11, 3) mm in `ROLES` order."""
+#: Tail markers of the rigid tail fit (``tail_fit="rigid"``); the head has only its two
+#: top markers (its spoke rings on its skewer).
+TAIL_RIGID = ("tail_top_1", "tail_top_2", "tail_back")
+#: Markers on the tail's flippers (``tail_fit="rigid+flippers"``): each moves on a circle
+#: about its hinge, fixed in the tail frame. The head's flippers open by at most ~0.45 rad
+#: on the simulator, too little arc for a well-determined circle.
+TAIL_HINGED = ("flipper_3", "flipper_4")
+
+
+def measure(xyz: np.ndarray, tail_fit: str = "rigid+flippers") -> Measured:
+    """Plane and segment frames from cleaned tracks (n_frames, 11, 3) mm in `ROLES` order.
+
+    ``tail_fit``: ``"top"`` takes the tail frame from its two top markers, like the head;
+    ``"rigid"`` refines it by a per-frame rigid fit of `TAIL_RIGID` (`rigid_fit`);
+    ``"rigid+flippers"`` then also uses that each of `TAIL_HINGED` stays on its circle
+    about its hinge (`hinged_fit`).
+    """
     xyz = np.asarray(xyz, dtype=float)
     top = xyz[:, [_ROLE[r] for r in TOP]]
     plane = fit_plane(xyz[:, [_ROLE[r] for r in RIGID]], top)
@@ -44,6 +62,15 @@ def measure(xyz: np.ndarray) -> Measured:
         local[:, [_ROLE["head_top_1"], _ROLE["head_top_2"]]],
         local[:, [_ROLE["tail_top_1"], _ROLE["tail_top_2"]]],
     )
+    if tail_fit not in TAIL_FITS:
+        raise ValueError(f"tail_fit={tail_fit!r}: expected one of {', '.join(TAIL_FITS)}")
+    if tail_fit != "top":
+        rigid = local[:, [_ROLE[r] for r in TAIL_RIGID]]
+        origin, angle = rigid_fit(rigid, frames.tail_origin, frames.tail_angle)
+        if tail_fit == "rigid+flippers":
+            hinged = local[:, [_ROLE[r] for r in TAIL_HINGED]]
+            origin, angle = hinged_fit(rigid, hinged, origin, angle)
+        frames = SegmentFrames(frames.head_origin, frames.head_angle, origin, angle)
     return Measured(plane, local, frames)
 
 

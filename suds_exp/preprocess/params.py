@@ -21,6 +21,10 @@ DEFAULTS: dict[str, Any] = {
     "max_gap_s": 0.25,  # refuse a trial whose longest gap to fill exceeds this, s
     # body frame
     "joint_fit": "version",  # segment origins fitted over all trials of the version | per trial
+    # tail frame: rigid = per-frame least-squares fit of tail_top_1, tail_top_2, tail_back
+    # (less noise in the body pose and velocity); rigid+flippers = that, plus the tail
+    # flipper markers staying on their circles about the hinges | top = its two top markers
+    "tail_fit": "rigid+flippers",
     # shape
     "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
     "shape_polyorder": 5,  # its polynomial order
@@ -31,14 +35,18 @@ DEFAULTS: dict[str, Any] = {
     "phaser_channels": "ra",  # signals the phase is estimated from: ra | ra+rp
     "phaser_pad_cycles": 2.0,  # periodic padding at each end against Hilbert edge effects, cycles
     # rates (Savitzky-Golay differentiator)
-    # window in gait cycles when the trial's frequency is known (0 = always use seconds);
-    # 0.1 cycles minimised the body-velocity error against the simulator's truth
-    "sg_window_cycles": 0.1,
+    # window when the trial's frequency is known: sg_window_cycles * T**sg_window_exponent
+    # seconds, T the gait period in s (cycles at a 1 s period; 0 = always use seconds);
+    # 0.13 and 0.67 minimised the body-velocity error against the simulator's truth
+    # (windows of 27, 21, 13 frames at 1/3, 1/2, 1 Hz)
+    "sg_window_cycles": 0.13,
+    "sg_window_exponent": 0.67,  # 1 = a fixed number of cycles, 0 = fixed seconds
     "sg_window_s": 0.21,  # window in seconds for trials without a frequency (odd frames)
     "sg_polyorder": 3,  # polynomial order
 }
 
 JOINT_FITS = ("version", "trial")
+TAIL_FITS = ("rigid+flippers", "rigid", "top")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
 MAX_K = 12
@@ -74,6 +82,10 @@ def _check(params: dict[str, Any]) -> None:
     for key in ("phaser_pad_cycles", "shape_window_s", "sg_window_cycles"):
         if params[key] < 0:
             raise ConfigError(f"--param {key}={params[key]}: must be >= 0")
+    if not 0 <= params["sg_window_exponent"] <= 2:
+        raise ConfigError(
+            f"--param sg_window_exponent={params['sg_window_exponent']}: must be 0..2"
+        )
     if not 1 <= params["k"] <= MAX_K:
         raise ConfigError(f"--param k={params['k']}: must be between 1 and {MAX_K}")
     for key in ("sg_polyorder", "shape_polyorder"):
@@ -81,6 +93,7 @@ def _check(params: dict[str, Any]) -> None:
             raise ConfigError(f"--param {key}={params[key]}: must be 1..6")
     for key, choices in (
         ("joint_fit", JOINT_FITS),
+        ("tail_fit", TAIL_FITS),
         ("phaser_group", PHASER_GROUPS),
         ("phaser_channels", PHASER_CHANNELS),
     ):

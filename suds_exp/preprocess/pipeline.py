@@ -217,7 +217,7 @@ def _prepare(meta_row, tracks, params: dict) -> _Trial:
     max_gap = int(np.floor(params["max_gap_s"] * rate + 1e-9))
     try:
         cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in ROLES])
-        measured = measure(cleaned.xyz)
+        measured = measure(cleaned.xyz, params["tail_fit"])
     except PreprocessError as exc:
         raise PreprocessError(f"{label}: {exc}") from None
     gait = meta_row.gait if isinstance(meta_row.gait, str) else None

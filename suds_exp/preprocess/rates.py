@@ -28,10 +28,19 @@ def window_frames(window_s: float, rate_hz: float, polyorder: int, n_frames: int
 def differentiator_window(
     params: dict, rate_hz: float, frequency_hz: float | None, n_frames: int
 ) -> int:
-    """A version's differentiator window, frames: ``sg_window_cycles`` gait periods when set
-    and the trial's frequency (Hz) is known, else ``sg_window_s`` seconds."""
+    """A version's differentiator window, frames.
+
+    When ``sg_window_cycles`` is set and the trial's frequency (Hz) is known, the window is
+    ``sg_window_cycles * T**sg_window_exponent`` seconds, T = 1 / frequency the gait period
+    in s: ``sg_window_cycles`` cycles at a 1 s period, growing as the period to the power
+    ``sg_window_exponent`` (1 = a fixed number of cycles, 0 = fixed seconds; in between, a
+    slower gait, whose features are slower, gets a longer window but fewer cycles, since
+    the marker noise the window averages is the same at every frequency). Otherwise
+    ``sg_window_s`` seconds."""
     if params["sg_window_cycles"] > 0 and frequency_hz:
-        window_s = params["sg_window_cycles"] / frequency_hz
+        # versions made before the exponent existed used a fixed number of cycles
+        exponent = params.get("sg_window_exponent", 1.0)
+        window_s = params["sg_window_cycles"] * (1.0 / frequency_hz) ** exponent
     else:
         window_s = params["sg_window_s"]
     return window_frames(window_s, rate_hz, params["sg_polyorder"], n_frames)
