@@ -95,6 +95,24 @@ def simulate_measured(
     return store
 
 
+def hidden_models(
+    hidden: dict[str, dict], model: SimConfig | None = None
+) -> tuple[SimConfig, SimConfig]:
+    """(truth, starting model) of a hidden-effect run: the nominal robot with ``hidden``
+    set, and ``model`` or, by default, the nominal model with every hidden effect
+    switched off (an effect the nominal robot already has, spoke_oscillation, is hidden
+    only by starting from a model without it)."""
+    truth = SimConfig()
+    start = model or SimConfig()
+    for effect, settings in hidden.items():
+        truth = set_effect(truth, effect, settings)
+        if model is None:
+            spec = main_parameter(effect)
+            if not isinstance(spec["off"], str):
+                start = set_effect(start, effect, {spec["name"]: spec["off"]})
+    return truth, start
+
+
 def hidden_effect_run(
     hidden: dict[str, dict] | None = None,
     seed: int = 0,
@@ -117,16 +135,7 @@ def hidden_effect_run(
     ``result.gap_before``, ``result.gap_after``).
     """
     hidden = dict(hidden or {})
-    truth = SimConfig()
-    start = model or SimConfig()
-    for effect, settings in hidden.items():
-        truth = set_effect(truth, effect, settings)
-        if model is None:
-            # an effect the nominal robot already has (spoke_oscillation) is hidden by
-            # starting from a model without it
-            spec = main_parameter(effect)
-            if not isinstance(spec["off"], str):
-                start = set_effect(start, effect, {spec["name"]: spec["off"]})
+    truth, start = hidden_models(hidden, model)
     opts = options or DiscrepancyOptions(seed=seed)
     with tempfile.TemporaryDirectory(prefix="suds-discrepancy-") as tmp:
         base = Path(workdir) if workdir is not None else Path(tmp)
@@ -134,7 +143,7 @@ def hidden_effect_run(
         result = run_discrepancy(
             store,
             "v1",
-            model or SimConfig(),
+            start,
             name=f"hidden-{seed}",
             options=opts,
             out=out,

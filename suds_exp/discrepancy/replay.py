@@ -3,7 +3,9 @@
 Cost is what shapes this module. A candidate fit needs the simulator's answer for many
 parameter values on many trials, so the replay runs on short windows (a few cycles of
 each trial), at a fixed number of samples per gait cycle (the quasi-static physics does
-not need 100 Hz), and stacks every window x configuration of one evaluation into one
+not need 100 Hz) but never coarser than `ReplaySettings.max_step_s` (the spoke markers'
+ringing, compared through the passive shape, is excited by accelerations a coarse step
+would smooth away), and stacks every window x configuration of one evaluation into one
 simulator call per frame interval.
 
 A window starts with a warm-up (flipper angles and the body-inertia state forget their
@@ -55,6 +57,12 @@ class ReplaySettings:
         Replayed but not scored before each window, gait cycles.
     samples_per_cycle : int
         Simulator steps per gait cycle (the decimation; 100 Hz capture at 1 Hz is 100).
+    max_step_s : float
+        Longest simulator step (s), whatever the gait frequency; 0: no limit. The spoke
+        markers ring at ~5 Hz, excited by the body's and segments' accelerations; at 40
+        steps per cycle a 1/3 Hz gait would step every 75 ms, the interpolated pose
+        would lose that excitation and a replay with the true spoke gain would look
+        worse than one without. 25 ms (8 steps per 5 Hz period) resolves it.
     sg_window_s, sg_window_cycles, sg_window_exponent, sg_polyorder : float, float, float, int
         The preprocessing version's Savitzky-Golay differentiator: window in s, or
         ``sg_window_cycles * T**sg_window_exponent`` s (T the gait period, s) when
@@ -74,6 +82,7 @@ class ReplaySettings:
     cycles_per_window: float = 1.0
     warmup_cycles: float = 1.0
     samples_per_cycle: int = 40
+    max_step_s: float = 0.025
     sg_window_s: float = 0.21
     sg_window_cycles: float = 0.0
     sg_window_exponent: float = 1.0
@@ -216,6 +225,8 @@ def make_windows(
         freq = float(freq)
         period_frames = 1.0 / (freq * dt_cap)
         step = max(1, int(round(period_frames / s.samples_per_cycle)))
+        if s.max_step_s > 0:
+            step = max(1, min(step, int(s.max_step_s / dt_cap + 1e-9)))
         sg_s = (
             s.sg_window_cycles * (1.0 / freq) ** s.sg_window_exponent
             if s.sg_window_cycles > 0

@@ -61,9 +61,8 @@ class DiscrepancyOptions:
         its value and interval are not biased by the replay's discretisation.
     passive : bool
         Compare the passive shape r_p too (when the preprocessing version has one); the
-        loss then weighs body velocity and passive shape half and half. Off by default:
-        the benchmarks were measured on body velocity alone; on makes `spoke_oscillation`
-        (markers only) fittable, though weakly, since r_p keeps only k PCA components.
+        loss then weighs body velocity and passive shape half and half. On by default:
+        it is what makes `flippers` and `spoke_oscillation` (markers only) visible.
     gap_floor : float
         Held-out loss (mean squared residual over each channel's mean square, so 0.01 is
         a residual of about 10% of the signal) below which a remaining gap is called
