@@ -97,8 +97,8 @@ def main() -> None:
     band = {c: figures[f"{c}_band_pct_of_rms_vx"] for c in ("err_vx", "err_vy", "err_wz")}
     print(
         f"body velocity error, % of RMS vx ({rms_vx:.1f} mm/s), target <= 5: raw truth "
-        f"vx {pct['err_vx']:.1f}, vy {pct['err_vy']:.1f}, wz {pct['err_wz']:.2f}; "
-        f"band-limited truth vx {band['err_vx']:.1f}, vy {band['err_vy']:.1f}, "
+        f"vx {pct['err_vx']:.2f}, vy {pct['err_vy']:.2f}, wz {pct['err_wz']:.2f}; "
+        f"band-limited truth vx {band['err_vx']:.2f}, vy {band['err_vy']:.2f}, "
         f"wz {band['err_wz']:.2f}"
     )
     print(

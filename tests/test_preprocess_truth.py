@@ -67,17 +67,30 @@ def test_default_dataset_within_targets_and_under_30_s(default_dataset):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="0.2 mm marker noise against truth velocities with sharp features (flipper stops): "
-    "the best Savitzky-Golay window rule leaves 5.1 % (vx) and 5.9 % (vy) of RMS vx against "
-    "the 5 % target; the markers' own share (band-limited truth) is 3.0 % / 3.5 %",
-)
 def test_default_dataset_body_velocity_within_5_percent_of_raw_truth(default_dataset):
     store, result, _ = default_dataset
     pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]
     for column in ("err_vx", "err_vy", "err_wz"):
         assert pooled[column] <= 0.05 * pooled.rms_vx_true, column
+
+
+def test_chain_body_fit_beats_the_segment_frames_against_the_truth(small):
+    """The default version (chain pose, triweight differentiator) against the version with
+    the body pose of the segment frames and plain Savitzky-Golay: two versions, and the
+    default one has the smaller body-velocity errors."""
+    chain = preprocess(small, progress=False)
+    segments = preprocess(
+        small, params={"body_fit": "segments", "sg_kernel": "box"}, progress=False
+    )
+    assert segments.version_id != chain.version_id
+    errs = {
+        r.version_id: truth_errors(small, r.version_id).set_index("trial_id").loc[-1]
+        for r in (chain, segments)
+    }
+    for column in ("err_vx", "err_vy", "err_wz"):
+        assert errs[chain.version_id][column] < errs[segments.version_id][column], column
+    # the same r_a: the shape still comes from the segment frames
+    assert errs[chain.version_id].err_ra == pytest.approx(errs[segments.version_id].err_ra)
 
 
 def test_cleaning_finds_the_simulators_jumps_and_keeps_every_clean_point(small):

@@ -30,6 +30,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import savgol_filter
 
+from suds_exp.preprocess.rates import derivative
 from suds_exp.preprocess.shape import PASSIVE_ROLES
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.markers import (
@@ -64,9 +65,12 @@ class ReplaySettings:
         would lose that excitation and a replay with the true spoke gain would look
         worse than one without. 25 ms (8 steps per 5 Hz period) resolves it.
     sg_window_s, sg_window_cycles, sg_window_exponent, sg_polyorder : float, float, float, int
-        The preprocessing version's Savitzky-Golay differentiator: window in s, or
+        The preprocessing version's local-polynomial differentiator: window in s, or
         ``sg_window_cycles * T**sg_window_exponent`` s (T the gait period, s) when
         ``sg_window_cycles`` > 0, and its order.
+    sg_kernel : str
+        Its weights over the window (`suds_exp.preprocess.rates.KERNELS`; ``box`` is
+        Savitzky-Golay).
     solver_tol : float
         Scaled residual tolerance of the simulator's per-step solve during replay.
     ra_smooth_s : float
@@ -87,6 +91,7 @@ class ReplaySettings:
     sg_window_cycles: float = 0.0
     sg_window_exponent: float = 1.0
     sg_polyorder: int = 3
+    sg_kernel: str = "box"
     solver_tol: float = 1e-7
     ra_smooth_s: float = 0.0
     shape_window_s: float = 0.21
@@ -180,6 +185,7 @@ def settings_from_prep(params: dict, **overrides) -> ReplaySettings:
         sg_window_cycles=float(params.get("sg_window_cycles", 0.0)),
         sg_window_exponent=float(params.get("sg_window_exponent", 1.0)),
         sg_polyorder=int(params.get("sg_polyorder", 3)),
+        sg_kernel=str(params.get("sg_kernel", "box")),
         shape_window_s=float(params.get("shape_window_s", 0.21)),
         shape_polyorder=int(params.get("shape_polyorder", 5)),
         **overrides,
@@ -357,8 +363,10 @@ def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
         fine_t = np.arange(g.n_fine)
         fine = CubicSpline(coarse_t, pose, axis=1)(fine_t)
         dt_cap = g.dt / g.step
-        rates = savgol_filter(
-            fine, g.sg_frames, s.sg_polyorder, deriv=1, delta=dt_cap, axis=1, mode="interp"
+        rates = np.moveaxis(
+            derivative(np.moveaxis(fine, 1, 0), dt_cap, g.sg_frames, s.sg_polyorder, s.sg_kernel),
+            0,
+            1,
         )
         sc = slice(g.score_from, g.score_from + g.n_scored)
         heading = fine[:, sc, 2]

@@ -146,7 +146,7 @@ HINGE_MIN_ARC_RAD = 0.3
 HINGE_MAX_RMS_MM = 1.0
 
 
-def _to_frame(points: np.ndarray, origin: np.ndarray, angle: np.ndarray) -> np.ndarray:
+def to_frame(points: np.ndarray, origin: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Plane points (n, m, 2) into per-frame 2D frames (origin (n, 2), angle (n,))."""
     rel = points - origin[:, None, :]
     c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
@@ -165,6 +165,25 @@ def _circle(u: np.ndarray) -> tuple[np.ndarray, float, float, float]:
     ang = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
     arc = float(np.percentile(ang, 95) - np.percentile(ang, 5))
     return centre, radius, rms, arc
+
+
+def hinge_circles(
+    hinged: np.ndarray, origin: np.ndarray, angle: np.ndarray
+) -> list[tuple[int, np.ndarray, float]]:
+    """The well-determined circles of hinged markers in a segment frame.
+
+    ``hinged`` (n_frames, h, 2) mm in the plane; ``origin`` (n_frames, 2) mm and ``angle``
+    (n_frames,) rad: the segment frame. Returns ``(k, centre (2,) mm, radius mm)`` for each
+    marker k whose points span at least `HINGE_MIN_ARC_RAD` and lie within
+    `HINGE_MAX_RMS_MM` of their algebraic least-squares circle.
+    """
+    local = to_frame(hinged, origin, angle)
+    circles = []
+    for k in range(hinged.shape[1]):
+        centre, radius, rms, arc = _circle(local[:, k])
+        if arc >= HINGE_MIN_ARC_RAD and rms <= HINGE_MAX_RMS_MM:
+            circles.append((k, centre, radius))
+    return circles
 
 
 def hinged_fit(
@@ -189,13 +208,8 @@ def hinged_fit(
     first estimate (forward-difference Jacobian). Returns (origin (n_frames, 2) mm,
     angle (n_frames,) rad).
     """
-    template = _to_frame(rigid, origin, angle).mean(axis=0)
-    local = _to_frame(hinged, origin, angle)
-    circles = []
-    for k in range(hinged.shape[1]):
-        centre, radius, rms, arc = _circle(local[:, k])
-        if arc >= HINGE_MIN_ARC_RAD and rms <= HINGE_MAX_RMS_MM:
-            circles.append((k, centre, radius))
+    template = to_frame(rigid, origin, angle).mean(axis=0)
+    circles = hinge_circles(hinged, origin, angle)
     if not circles:
         return origin, angle
 
@@ -207,7 +221,7 @@ def hinged_fit(
             axis=-1,
         )
         out = [(o[:, None, :] + placed - rigid).reshape(len(x), -1)]
-        u = _to_frame(hinged[:, [k for k, _, _ in circles]], o, a)
+        u = to_frame(hinged[:, [k for k, _, _ in circles]], o, a)
         for j, (_, centre, radius) in enumerate(circles):
             d = u[:, j] - centre
             out.append((np.hypot(d[:, 0], d[:, 1]) - radius)[:, None])

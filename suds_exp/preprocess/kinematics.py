@@ -18,6 +18,7 @@ from suds_exp.preprocess.body_frame import (
     rigid_fit,
     segment_frames,
 )
+from suds_exp.preprocess.chain import chain_pose
 from suds_exp.preprocess.params import TAIL_FITS
 from suds_exp.preprocess.shape import PASSIVE_ROLES, actuated_shape, passive_state
 
@@ -96,10 +97,21 @@ class Kinematics:
     passive: np.ndarray
 
 
-def kinematics(measured: Measured, joints: Joints) -> Kinematics:
-    """Body pose, r_a and passive state of a measured trial given its segment origins."""
+def kinematics(
+    measured: Measured, joints: Joints, chain: tuple[int, int] | None = None
+) -> Kinematics:
+    """Body pose, r_a and passive state of a measured trial given its segment origins.
+
+    ``chain``: (window frames, polynomial order) of the relative-angle smoothing of
+    `chain_pose`, which then gives the body pose (``xy``, ``heading``); None keeps the pose
+    of the segment frames (`body_pose`). r_a and the passive state come from the segment
+    frames either way.
+    """
     pose = body_pose(measured.frames, joints)
     ra = actuated_shape(measured.frames, pose)
     points = {r: measured.local[:, _ROLE[r]] for r, _ in PASSIVE_ROLES}
     passive = passive_state(measured.frames, pose, points)
-    return Kinematics(pose.xy, pose.heading, ra, passive)
+    xy, heading = pose.xy, pose.heading
+    if chain is not None:
+        xy, heading = chain_pose(measured.local, measured.frames, joints, *chain)
+    return Kinematics(xy, heading, ra, passive)

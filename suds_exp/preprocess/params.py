@@ -25,6 +25,17 @@ DEFAULTS: dict[str, Any] = {
     # (less noise in the body pose and velocity); rigid+flippers = that, plus the tail
     # flipper markers staying on their circles about the hinges | top = its two top markers
     "tail_fit": "rigid+flippers",
+    # body pose: chain = one fit of all rigid markers and the tail flipper circles per
+    # frame, with the segments' angles relative to the body smoothed (suds_exp.preprocess.
+    # chain) | segments = the midpoint and direction of the motor axes of the segment frames
+    "body_fit": "chain",
+    # smoothing of those relative angles (body_fit=chain): chain_window_cycles gait cycles
+    # when the trial's frequency is known, else chain_window_s seconds; local polynomial
+    # of order chain_polyorder. 0.3 cycles and order 7 minimised the body-velocity error
+    # against the simulator's truth (0.25-0.4 cycles and orders 6-8 are within 0.05 %)
+    "chain_window_cycles": 0.3,
+    "chain_window_s": 0.6,
+    "chain_polyorder": 7,
     # shape
     "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
     "shape_polyorder": 5,  # its polynomial order
@@ -43,10 +54,14 @@ DEFAULTS: dict[str, Any] = {
     "sg_window_exponent": 0.67,  # 1 = a fixed number of cycles, 0 = fixed seconds
     "sg_window_s": 0.21,  # window in seconds for trials without a frequency (odd frames)
     "sg_polyorder": 3,  # polynomial order
+    # weights over the window: triweight (1 - (j/(h+1))^2)^3 | box (plain Savitzky-Golay)
+    "sg_kernel": "triweight",
 }
 
 JOINT_FITS = ("version", "trial")
 TAIL_FITS = ("rigid+flippers", "rigid", "top")
+BODY_FITS = ("chain", "segments")
+SG_KERNELS = ("triweight", "box")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
 MAX_K = 12
@@ -75,11 +90,11 @@ def _coerce(key: str, value: Any) -> Any:
 
 
 def _check(params: dict[str, Any]) -> None:
-    positive = ("jump_mm", "max_gap_s", "sg_window_s", "phaser_order")
+    positive = ("jump_mm", "max_gap_s", "sg_window_s", "chain_window_s", "phaser_order")
     for key in positive:
         if not params[key] > 0:
             raise ConfigError(f"--param {key}={params[key]}: must be > 0")
-    for key in ("phaser_pad_cycles", "shape_window_s", "sg_window_cycles"):
+    for key in ("phaser_pad_cycles", "shape_window_s", "sg_window_cycles", "chain_window_cycles"):
         if params[key] < 0:
             raise ConfigError(f"--param {key}={params[key]}: must be >= 0")
     if not 0 <= params["sg_window_exponent"] <= 2:
@@ -88,12 +103,14 @@ def _check(params: dict[str, Any]) -> None:
         )
     if not 1 <= params["k"] <= MAX_K:
         raise ConfigError(f"--param k={params['k']}: must be between 1 and {MAX_K}")
-    for key in ("sg_polyorder", "shape_polyorder"):
-        if not 1 <= params[key] <= 6:
-            raise ConfigError(f"--param {key}={params[key]}: must be 1..6")
+    for key, top in (("sg_polyorder", 6), ("shape_polyorder", 6), ("chain_polyorder", 9)):
+        if not 1 <= params[key] <= top:
+            raise ConfigError(f"--param {key}={params[key]}: must be 1..{top}")
     for key, choices in (
         ("joint_fit", JOINT_FITS),
         ("tail_fit", TAIL_FITS),
+        ("body_fit", BODY_FITS),
+        ("sg_kernel", SG_KERNELS),
         ("phaser_group", PHASER_GROUPS),
         ("phaser_channels", PHASER_CHANNELS),
     ):

@@ -22,6 +22,7 @@ import sqlalchemy as sa
 
 from suds_exp.ingest.layout import ROLES, trial_layout
 from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
+from suds_exp.preprocess.chain import chain_settings
 from suds_exp.preprocess.clean import CleanResult, clean_tracks
 from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
@@ -254,11 +255,11 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
     dt = 1.0 / tr.rate_hz
     ra, passive = _smoothed(tr, params)
     w = differentiator_window(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
-    po = params["sg_polyorder"]
-    dra = derivative(tr.kin.ra, dt, w, po)
-    drp = pca.transform_rate(derivative(tr.kin.passive, dt, w, po))
+    po, kernel = params["sg_polyorder"], params.get("sg_kernel", "box")
+    dra = derivative(tr.kin.ra, dt, w, po, kernel)
+    drp = pca.transform_rate(derivative(tr.kin.passive, dt, w, po, kernel))
     rp = pca.transform(passive)
-    vb = body_velocity(tr.kin.xy, tr.kin.heading, dt, w, po)
+    vb = body_velocity(tr.kin.xy, tr.kin.heading, dt, w, po, kernel)
     phase = phaser.transform(_phaser_input(tr, pca, params))
     n = len(tr.t)
     cols: dict[str, Any] = {
@@ -427,7 +428,8 @@ def preprocess(
     else:
         joints = {tr.id: fit_joints(tr.measured.frames) for tr in items}
     for tr in items:
-        tr.kin = kinematics(tr.measured, joints[tr.id])
+        chain = chain_settings(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
+        tr.kin = kinematics(tr.measured, joints[tr.id], chain)
     if ("pca", "") in fits:
         pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
     else:

@@ -61,7 +61,12 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
         heading = np.unwrap(truth.theta.to_numpy())
         window = differentiator_window(params, rate[tid], s.frequency_hz.iloc[0], len(truth))
         band = body_velocity(
-            truth[["x", "y"]].to_numpy(), heading, 1.0 / rate[tid], window, params["sg_polyorder"]
+            truth[["x", "y"]].to_numpy(),
+            heading,
+            1.0 / rate[tid],
+            window,
+            params["sg_polyorder"],
+            params.get("sg_kernel", "box"),
         )
         e = pd.DataFrame(
             {
