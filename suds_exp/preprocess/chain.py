@@ -142,6 +142,8 @@ def chain_pose(
         number of frames; ``window <= polyorder`` leaves them unsmoothed).
     rounds : int
         Alternations of (relative angles | pose) and (pose | relative angles).
+    newton_steps : int
+        Gauss-Newton steps of the pose fit with the flipper circles, per round.
 
     Returns
     -------
