@@ -109,6 +109,85 @@ def segment_frames(head_top: np.ndarray, tail_top: np.ndarray) -> SegmentFrames:
     return SegmentFrames(ho, ha, to, ta)
 
 
+def rotate(angle: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Rotate 2-vectors ``v`` (n, ..., 2), or (1, ..., 2) for the same vectors in every
+    frame, by per-frame angles ``angle`` (n,) rad."""
+    shape = (len(angle),) + (1,) * (v.ndim - 2)
+    c, s = np.cos(angle).reshape(shape), np.sin(angle).reshape(shape)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+def to_frame(points: np.ndarray, origin: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Plane points (n, m, 2) into per-frame 2D frames (origin (n, 2), angle (n,))."""
+    return rotate(-angle, points - origin[:, None, :])
+
+
+def best_rotation(template: np.ndarray, points: np.ndarray, near: np.ndarray) -> np.ndarray:
+    """Per-frame angle (n,) rad of the rotation about the origin that best maps
+    ``template`` ((m, 2) or (n, m, 2)) onto ``points`` (n, m, 2) (least squares, closed
+    form), unwrapped next to ``near`` (n,)."""
+    sxx = (template[..., 0] * points[..., 0] + template[..., 1] * points[..., 1]).sum(axis=-1)
+    sxy = (template[..., 0] * points[..., 1] - template[..., 1] * points[..., 0]).sum(axis=-1)
+    return near + np.angle(np.exp(1j * (np.arctan2(sxy, sxx) - near)))
+
+
+def procrustes(
+    template: np.ndarray, points: np.ndarray, near: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame 2D rigid transform best mapping ``template`` ((m, 2) or (n, m, 2), in the
+    frame) onto ``points`` (n, m, 2) in the plane, equal weights, closed form: (origin
+    (n, 2), angle (n,) rad, unwrapped next to ``near``)."""
+    t_c = template.mean(axis=-2, keepdims=True)
+    p_c = points.mean(axis=1, keepdims=True)
+    angle = best_rotation(template - t_c, points - p_c, near)
+    t_c = np.broadcast_to(t_c, (len(points), 1, 2))
+    return (p_c - rotate(angle, t_c))[:, 0], angle
+
+
+def refine_with_circles(
+    origin: np.ndarray,
+    angle: np.ndarray,
+    template: np.ndarray,
+    points: np.ndarray,
+    circles: list[tuple[np.ndarray, np.ndarray, float]],
+    iterations: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Newton refinement of per-frame 2D frames (origin (n, 2) mm, angle (n,) rad).
+
+    Minimises, per frame, the squared misfits of ``template`` ((m, 2) or (n, m, 2) mm, in
+    the frame) against ``points`` (n, m, 2) mm in the plane, plus, for each circle
+    ``(marker (n, 2) mm in the plane, centre ((2,) or (n, 2) mm in the frame, radius
+    mm)``, the squared distance of the marker from its circle (one equation each: the
+    hinged part's angle stays free). Analytic Jacobian."""
+    n = len(points)
+    m = points.shape[1]
+    x = np.column_stack([origin, angle])
+    for _ in range(iterations):
+        placed = rotate(x[:, 2], np.broadcast_to(template, (n, m, 2)))
+        res = [(x[:, None, :2] + placed - points).reshape(n, 2 * m)]
+        jac = np.zeros((n, 2 * m, 3))
+        jac[:, 0::2, 0] = 1.0
+        jac[:, 1::2, 1] = 1.0
+        jac[:, 0::2, 2] = -placed[..., 1]
+        jac[:, 1::2, 2] = placed[..., 0]
+        jacs = [jac]
+        for marker, centre, radius in circles:
+            rc = rotate(x[:, 2], np.broadcast_to(centre, (n, 2))[:, None])[:, 0]
+            e = marker - x[:, :2] - rc
+            dist = np.hypot(e[:, 0], e[:, 1])
+            u = e / np.maximum(dist, 1e-9)[:, None]
+            res.append((dist - radius)[:, None])
+            # d(dist)/d(origin) = -u; d(dist)/d(angle) = -u . d(rc)/d(angle)
+            d_angle = u[:, 0] * rc[:, 1] - u[:, 1] * rc[:, 0]
+            jacs.append(np.concatenate([-u, d_angle[:, None]], axis=1)[:, None, :])
+        r = np.concatenate(res, axis=1)
+        jm = np.concatenate(jacs, axis=1)
+        hess = np.einsum("nij,nik->njk", jm, jm)
+        grad = np.einsum("nij,ni->nj", jm, r)
+        x = x - np.linalg.solve(hess, grad[..., None])[..., 0]
+    return x[:, :2], x[:, 2]
+
+
 def rigid_fit(
     points: np.ndarray, origin: np.ndarray, angle: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -123,20 +202,8 @@ def rigid_fit(
     down; the frame keeps the first estimate's convention, so the angle stays unwrapped
     alongside ``angle``. Returns (origin (n_frames, 2) mm, angle (n_frames,) rad).
     """
-    rel = points - origin[:, None, :]
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    template = np.stack(  # rel rotated by -angle, averaged over frames: (n_markers, 2)
-        [c * rel[..., 0] + s * rel[..., 1], -s * rel[..., 0] + c * rel[..., 1]], axis=-1
-    ).mean(axis=0)
-    t_c = template.mean(axis=0)
-    q = template - t_c
-    p_c = points.mean(axis=1)
-    p = points - p_c[:, None, :]
-    sxx = (q[:, 0] * p[..., 0] + q[:, 1] * p[..., 1]).sum(axis=1)
-    sxy = (q[:, 0] * p[..., 1] - q[:, 1] * p[..., 0]).sum(axis=1)
-    fitted = np.arctan2(sxy, sxx)
-    fitted = angle + np.angle(np.exp(1j * (fitted - angle)))
-    return p_c - _rot(fitted, t_c), fitted
+    template = to_frame(points, origin, angle).mean(axis=0)
+    return procrustes(template, points, angle)
 
 
 #: A hinged marker constrains its segment's frame only if its circle is well determined:
@@ -144,13 +211,6 @@ def rigid_fit(
 HINGE_MIN_ARC_RAD = 0.3
 #: ... and lying within this RMS distance of the fitted circle, mm.
 HINGE_MAX_RMS_MM = 1.0
-
-
-def to_frame(points: np.ndarray, origin: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Plane points (n, m, 2) into per-frame 2D frames (origin (n, 2), angle (n,))."""
-    rel = points - origin[:, None, :]
-    c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-    return np.stack([c * rel[..., 0] + s * rel[..., 1], -s * rel[..., 0] + c * rel[..., 1]], -1)
 
 
 def _circle(u: np.ndarray) -> tuple[np.ndarray, float, float, float]:
@@ -205,7 +265,7 @@ def hinged_fit(
     `HINGE_MAX_RMS_MM` from it) is left out. Each frame then minimises the squared
     rigid-marker misfits plus the squared distances of the hinged markers from their
     circles (one equation each: the flipper angle stays free), by Gauss-Newton from the
-    first estimate (forward-difference Jacobian). Returns (origin (n_frames, 2) mm,
+    first estimate (`refine_with_circles`). Returns (origin (n_frames, 2) mm,
     angle (n_frames,) rad).
     """
     template = to_frame(rigid, origin, angle).mean(axis=0)
@@ -213,39 +273,8 @@ def hinged_fit(
     if not circles:
         return origin, angle
 
-    def residuals(x: np.ndarray) -> np.ndarray:
-        o, a = x[:, :2], x[:, 2]
-        c, s = np.cos(a)[:, None], np.sin(a)[:, None]
-        placed = np.stack(
-            [c * template[:, 0] - s * template[:, 1], s * template[:, 0] + c * template[:, 1]],
-            axis=-1,
-        )
-        out = [(o[:, None, :] + placed - rigid).reshape(len(x), -1)]
-        u = to_frame(hinged[:, [k for k, _, _ in circles]], o, a)
-        for j, (_, centre, radius) in enumerate(circles):
-            d = u[:, j] - centre
-            out.append((np.hypot(d[:, 0], d[:, 1]) - radius)[:, None])
-        return np.concatenate(out, axis=1)
-
-    x = np.column_stack([origin, angle])
-    steps = (1e-4, 1e-4, 1e-6)  # mm, mm, rad
-    for _ in range(iterations):
-        r0 = residuals(x)
-        jac = np.empty((*r0.shape, 3))
-        for j, h in enumerate(steps):
-            dx = np.zeros(3)
-            dx[j] = h
-            jac[..., j] = (residuals(x + dx) - r0) / h
-        hess = np.einsum("nij,nik->njk", jac, jac)
-        grad = np.einsum("nij,ni->nj", jac, r0)
-        x = x - np.linalg.solve(hess, grad[..., None])[..., 0]
-    return x[:, :2], x[:, 2]
-
-
-def _rot(angle: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Rotate fixed 2-vector ``v`` by each angle: (n,) -> (n, 2)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1]], axis=-1)
+    chosen = [(hinged[:, k], centre, radius) for k, centre, radius in circles]
+    return refine_with_circles(origin, angle, template, rigid, chosen, iterations)
 
 
 @dataclass(frozen=True)
@@ -264,8 +293,8 @@ class Joints:
     def points(self, frames: SegmentFrames) -> tuple[np.ndarray, np.ndarray]:
         """Head and tail segment origins per frame, each (n_frames, 2) mm in the plane."""
         return (
-            frames.head_origin + _rot(frames.head_angle, self.head),
-            frames.tail_origin + _rot(frames.tail_angle, self.tail),
+            frames.head_origin + rotate(frames.head_angle, self.head[None]),
+            frames.tail_origin + rotate(frames.tail_angle, self.tail[None]),
         )
 
 
@@ -286,7 +315,7 @@ def fit_joints(frames: SegmentFrames) -> Joints:
     scale = np.abs(design).max(axis=0) + 1e-12
     u, *_ = np.linalg.lstsq(design / scale, rhs, rcond=None)
     u /= scale
-    gap = p + _rot(psi, u[:2]) - u[2:4]
+    gap = p + rotate(psi, u[None, :2]) - u[2:4]
     start = np.concatenate([u[:4], [np.sqrt(np.mean(np.sum(gap**2, axis=1)))]])
 
     step = max(1, len(p) // JOINT_FIT_FRAMES)
@@ -302,7 +331,7 @@ def fit_joints(frames: SegmentFrames) -> Joints:
     if not fit.success and fit.status <= 0:
         raise PreprocessError(f"segment origins: least squares did not converge ({fit.message})")
     ah, at = fit.x[:2], fit.x[2:4]
-    dist = np.hypot(*(p + _rot(psi, ah) - at).T)
+    dist = np.hypot(*(p + rotate(psi, ah[None]) - at).T)
     return Joints(ah, at, float(np.mean(dist)), float(np.sqrt(np.mean((dist - dist.mean()) ** 2))))
 
 

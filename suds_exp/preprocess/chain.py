@@ -31,8 +31,12 @@ from suds_exp.ingest.layout import ROLES
 from suds_exp.preprocess.body_frame import (
     Joints,
     SegmentFrames,
+    best_rotation,
     body_pose,
     hinge_circles,
+    procrustes,
+    refine_with_circles,
+    rotate,
     to_frame,
 )
 from suds_exp.preprocess.rates import local_polynomial, window_frames
@@ -42,79 +46,6 @@ _ROLE = {role: i for i, role in enumerate(ROLES)}
 HEAD_RIGID = ("head_top_1", "head_top_2")
 TAIL_RIGID = ("tail_top_1", "tail_top_2", "tail_back")
 TAIL_HINGED = ("flipper_3", "flipper_4")
-
-
-def _rotate(angle: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Rotate vectors v (n, ..., 2) by per-frame angles (n,)."""
-    shape = (len(angle),) + (1,) * (v.ndim - 2)
-    c, s = np.cos(angle).reshape(shape), np.sin(angle).reshape(shape)
-    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
-
-
-def _to_body(points: np.ndarray, xy: np.ndarray, heading: np.ndarray) -> np.ndarray:
-    """Plane points (n, m, 2) into the body frame of each frame."""
-    return _rotate(-heading, points - xy[:, None, :])
-
-
-def _about_hinge(template: np.ndarray, measured: np.ndarray, previous: np.ndarray) -> np.ndarray:
-    """Per-frame angle (n,) rotating ``template`` (m, 2) onto ``measured`` (n, m, 2), both
-    relative to the same hinge; unwrapped next to ``previous`` (n,)."""
-    sxx = (template[:, 0] * measured[..., 0] + template[:, 1] * measured[..., 1]).sum(axis=1)
-    sxy = (template[:, 0] * measured[..., 1] - template[:, 1] * measured[..., 0]).sum(axis=1)
-    angle = np.arctan2(sxy, sxx)
-    return previous + np.angle(np.exp(1j * (angle - previous)))
-
-
-def _procrustes(body: np.ndarray, plane: np.ndarray, heading: np.ndarray):
-    """Per-frame rigid transform (xy (n, 2), heading (n,)) best mapping body-frame points
-    ``body`` (n, m, 2) onto plane points ``plane`` (n, m, 2); heading kept continuous."""
-    bc, pc = body.mean(axis=1), plane.mean(axis=1)
-    b, p = body - bc[:, None], plane - pc[:, None]
-    sxx = (b[..., 0] * p[..., 0] + b[..., 1] * p[..., 1]).sum(axis=1)
-    sxy = (b[..., 0] * p[..., 1] - b[..., 1] * p[..., 0]).sum(axis=1)
-    angle = np.arctan2(sxy, sxx)
-    angle = heading + np.angle(np.exp(1j * (angle - heading)))
-    return pc - _rotate(angle, bc[:, None, :])[:, 0], angle
-
-
-def _gauss_newton(xy, heading, body, plane, circles, iterations):
-    """Refine the pose with the circle residuals: rigid misfits (x, y of each marker) plus,
-    for each circle, the distance of its marker from the circle (analytic Jacobian)."""
-    n, m = body.shape[:2]
-    x = np.column_stack([xy, heading])
-    for _ in range(iterations):
-        c, s = np.cos(x[:, 2])[:, None], np.sin(x[:, 2])[:, None]
-        placed = np.stack(
-            [c * body[..., 0] - s * body[..., 1], s * body[..., 0] + c * body[..., 1]], -1
-        )
-        res = [(x[:, None, :2] + placed - plane).reshape(n, 2 * m)]
-        jac = np.zeros((n, 2 * m, 3))
-        jac[:, 0::2, 0] = 1.0
-        jac[:, 1::2, 1] = 1.0
-        jac[:, 0::2, 2] = -placed[..., 1]
-        jac[:, 1::2, 2] = placed[..., 0]
-        jacs = [jac]
-        for marker, centre, radius in circles:
-            rc = np.stack(
-                [
-                    c[:, 0] * centre[:, 0] - s[:, 0] * centre[:, 1],
-                    s[:, 0] * centre[:, 0] + c[:, 0] * centre[:, 1],
-                ],
-                -1,
-            )
-            e = marker - x[:, :2] - rc
-            dist = np.hypot(e[:, 0], e[:, 1])
-            u = e / np.maximum(dist, 1e-9)[:, None]
-            res.append((dist - radius)[:, None])
-            # d(dist)/d(xy) = -u; d(dist)/d(heading) = -u . d(rc)/d(heading)
-            dtheta = -(u[:, 0] * -rc[:, 1] + u[:, 1] * rc[:, 0])
-            jacs.append(np.concatenate([-u, dtheta[:, None]], axis=1)[:, None, :])
-        r = np.concatenate(res, axis=1)
-        jm = np.concatenate(jacs, axis=1)
-        hess = np.einsum("nij,nik->njk", jm, jm)
-        grad = np.einsum("nij,ni->nj", jm, r)
-        x = x - np.linalg.solve(hess, grad[..., None])[..., 0]
-    return x[:, :2], x[:, 2]
 
 
 def chain_pose(
@@ -156,7 +87,6 @@ def chain_pose(
     tail_origin, tail_angle = frames.tail_origin, frames.tail_angle
     pose = body_pose(frames, joints)
     xy, heading = pose.xy, pose.heading
-    n = len(heading)
     half = joints.length_mm / 2
     hinge = {"head": np.array([half, 0.0]), "tail": np.array([-half, 0.0])}
     marks = {
@@ -181,32 +111,24 @@ def chain_pose(
     for round_ in range(rounds):
         if round_:
             for seg in ("head", "tail"):
-                measured = _to_body(marks[seg], xy, heading) - hinge[seg]
-                relative[seg] = _about_hinge(template[seg], measured, relative[seg])
+                measured = to_frame(marks[seg], xy, heading) - hinge[seg]
+                relative[seg] = best_rotation(template[seg], measured, relative[seg])
         smooth = {
             seg: local_polynomial(a, window, polyorder) if window > polyorder else a
             for seg, a in relative.items()
         }
+        # the rigid markers and the circle centres in the body frame, per frame
         body = np.concatenate(
-            [
-                hinge[seg]
-                + _rotate(smooth[seg], np.broadcast_to(template[seg], (n, *template[seg].shape)))
-                for seg in ("head", "tail")
-            ],
+            [hinge[seg] + rotate(smooth[seg], template[seg][None]) for seg in ("head", "tail")],
             axis=1,
         )
-        xy, heading = _procrustes(body, plane, heading)
+        xy, heading = procrustes(body, plane, heading)
         if circles:
             in_body = [
-                (
-                    marker,
-                    hinge["tail"]
-                    + _rotate(smooth["tail"], np.broadcast_to(c, (n, 2))[:, None])[:, 0],
-                    r,
-                )
-                for marker, c, r in circles
+                (marker, hinge["tail"] + rotate(smooth["tail"], centre[None, None])[:, 0], r)
+                for marker, centre, r in circles
             ]
-            xy, heading = _gauss_newton(xy, heading, body, plane, in_body, newton_steps)
+            xy, heading = refine_with_circles(xy, heading, body, plane, in_body, newton_steps)
     return xy, heading
 
 
