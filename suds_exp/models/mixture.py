@@ -31,8 +31,9 @@ class Mixture:
         return K * (D + D * (D + 1) // 2) + K - 1
 
 
-def _prec_chol(cov: np.ndarray) -> np.ndarray:
-    """Upper factors P with P^T P = inv(cov), shape (K, D, D); raises ModelError."""
+def _cholesky(cov: np.ndarray) -> np.ndarray:
+    """Lower Cholesky factors of covariances (K, D, D); raises ModelError if one is not
+    positive definite."""
     try:
         L = np.linalg.cholesky(cov)
     except np.linalg.LinAlgError as exc:
@@ -40,6 +41,12 @@ def _prec_chol(cov: np.ndarray) -> np.ndarray:
             "Gaussian mixture: a component covariance is not positive definite; "
             "decrease n_components or increase reg_covar"
         ) from exc
+    return L
+
+
+def _prec_chol(cov: np.ndarray) -> np.ndarray:
+    """Upper factors P with P^T P = inv(cov), shape (K, D, D); raises ModelError."""
+    L = _cholesky(cov)
     eye = np.broadcast_to(np.eye(cov.shape[-1]), cov.shape)
     return np.swapaxes(np.linalg.solve(L, eye), -1, -2)
 
@@ -107,13 +114,7 @@ class _Moments:
 
     def log_gaussians(self, means, cov) -> np.ndarray:
         D = means.shape[1]
-        try:
-            L = np.linalg.cholesky(cov)
-        except np.linalg.LinAlgError as exc:
-            raise ModelError(
-                "Gaussian mixture: a component covariance is not positive definite; "
-                "decrease n_components or increase reg_covar"
-            ) from exc
+        L = _cholesky(cov)
         logdet = np.log(np.diagonal(L, axis1=1, axis2=2)).sum(axis=1)
         prec = np.linalg.inv(cov)
         lam = prec[:, self.iu[0], self.iu[1]] * self.offdiag
