@@ -186,7 +186,47 @@ BAD_FILES = {
         lambda tp: _bad_qtm(tp, "rate.tsv", lambda ls: _set(ls, 3, "FREQUENCY\t0")),
         "FREQUENCY: expected a positive number of Hz",
     ),
-    "unknown format": (lambda tp: _write(tp, "x.trc", "abc"), "unknown format '.trc'"),
+    "unknown format": (lambda tp: _write(tp, "x.xyz", "abc"), "unknown format '.xyz'"),
+    "not a trc": (lambda tp: _write(tp, "x.trc", "abc"), "line 1: not a TRC file"),
+    "trc truncated": (
+        lambda tp: _write(
+            tp,
+            "t.trc",
+            "PathFileType\t4\t(X/Y/Z)\tt.trc\nDataRate\tCameraRate\tNumFrames\tNumMarkers\t"
+            "Units\nx\t100\t3\t1\tmm\nFrame#\tTime\ta\n\t\tX1\tY1\tZ1\n1\t0\t1\t2\t3\n",
+        ),
+        "line 3, DataRate: expected a positive number of Hz, got 'x'",
+    ),
+    "vicon without trajectories": (
+        lambda tp: _write(tp, "v.csv", "Devices\n1000\n,,Plate\nFrame,Sub Frame,Fx\n,,N\n1,0,2\n"),
+        "without a 'Trajectories' block (blocks found: Devices)",
+    ),
+    "vicon unit": (
+        lambda tp: _write(
+            tp,
+            "u.csv",
+            "Trajectories\n100\n,,S:a,,\nFrame,Sub Frame,X,Y,Z\n,,in,in,in\n1,0,1,2,3\n",
+        ),
+        "line 5: length unit 'in'; expected mm, cm or m",
+    ),
+    "vicon gap token": (
+        lambda tp: _write(
+            tp,
+            "g.csv",
+            "Trajectories\n100\n,,S:a,,\nFrame,Sub Frame,X,Y,Z\n,,mm,mm,mm\n1,0,1,2,3\n2,0,1,?,3\n",
+        ),
+        "line 7, column 'S:a Y': expected a number, got '?'",
+    ),
+    "motive without markers": (
+        lambda tp: _write(
+            tp,
+            "o.csv",
+            "Format Version,1.23,Export Frame Rate,100,Length Units,Meters\n\n"
+            ",Type,Rigid Body,Rigid Body,Rigid Body\n,Name,RB,RB,RB\n,ID,1,1,1\n"
+            ",,Position,Position,Position\nFrame,Time (Seconds),X,Y,Z\n0,0,1,2,3\n",
+        ),
+        "holds no marker positions",
+    ),
     "missing file": (lambda tp: tp / "nope.tsv", "no such file"),
     "bad c3d": (
         lambda tp: _write(tp, "x.c3d", b"\x02P" + b"\x00" * 700),

@@ -13,7 +13,7 @@ from suds_exp.errors import IngestError
 from suds_exp.ingest import read_capture
 from suds_exp.ingest.csv_reader import write_marker_csv
 from tests.conftest import qtm_text, random_track
-from tests.test_ingest_formats import write_c3d
+from tests.test_ingest_formats import write_c3d, write_motive, write_trc, write_vicon
 
 FUZZ = settings(max_examples=120, deadline=None, suppress_health_check=list(HealthCheck))
 
@@ -26,7 +26,14 @@ def _seed_files() -> dict[str, bytes]:
     capture, _ = read_capture(folder / "s.tsv")
     write_marker_csv(folder / "s.csv", capture)
     write_c3d(folder / "s.c3d", names, xyz)
-    return {ext: (folder / f"s{ext}").read_bytes() for ext in (".tsv", ".csv", ".c3d")}
+    seeds = {ext: (folder / f"s{ext}").read_bytes() for ext in (".tsv", ".csv", ".c3d")}
+    for name, write in (
+        ("s.trc", write_trc),
+        ("vicon.csv", write_vicon),
+        ("motive.csv", write_motive),
+    ):
+        seeds[name] = write(folder / name, names, xyz).read_bytes()
+    return seeds
 
 
 SEEDS = _seed_files()
@@ -72,21 +79,20 @@ def _read_or_ingest_error(tmp: Path, ext: str, data: bytes) -> None:
 
 
 @FUZZ
-@given(
-    ext=st.sampled_from([".tsv", ".csv", ".c3d"]), ops=st.lists(mutation, min_size=1, max_size=4)
-)
-def test_mutated_files_ingest_or_raise_ingest_error(tmp_path_factory, ext, ops):
-    _read_or_ingest_error(tmp_path_factory.mktemp("fuzz"), ext, _mutate(SEEDS[ext], ops))
+@given(seed=st.sampled_from(sorted(SEEDS)), ops=st.lists(mutation, min_size=1, max_size=4))
+def test_mutated_files_ingest_or_raise_ingest_error(tmp_path_factory, seed, ops):
+    ext = Path(seed).suffix or seed
+    _read_or_ingest_error(tmp_path_factory.mktemp("fuzz"), ext, _mutate(SEEDS[seed], ops))
 
 
 @FUZZ
-@given(ext=st.sampled_from([".tsv", ".csv", ".c3d"]), data=st.binary(max_size=2000))
+@given(ext=st.sampled_from([".tsv", ".csv", ".c3d", ".trc"]), data=st.binary(max_size=2000))
 def test_random_bytes_ingest_or_raise_ingest_error(tmp_path_factory, ext, data):
     _read_or_ingest_error(tmp_path_factory.mktemp("rand"), ext, data)
 
 
 @FUZZ
-@given(ext=st.sampled_from([".tsv", ".csv"]), text=st.text(max_size=600))
+@given(ext=st.sampled_from([".tsv", ".csv", ".trc"]), text=st.text(max_size=600))
 def test_random_text_ingest_or_raise_ingest_error(tmp_path_factory, ext, text):
     _read_or_ingest_error(
         tmp_path_factory.mktemp("text"), ext, text.encode("utf-8", "surrogatepass")

@@ -96,23 +96,3 @@ class Capture:
                 "missing": missing,
             }
         )
-
-
-def parse_numeric_block(
-    path: Path, cells: pd.DataFrame, first_line: int, columns: list[str]
-) -> np.ndarray:
-    """Convert a block of text cells to floats; empty cells become NaN.
-
-    ``first_line`` is the 1-based file line of the block's first row, so an error can
-    name the line and column of the first cell that is not a number.
-    """
-    stripped = cells.apply(lambda c: c.str.strip())
-    values = stripped.apply(pd.to_numeric, errors="coerce")
-    bad = values.isna() & (stripped != "")
-    if bad.to_numpy().any():
-        row, col = np.argwhere(bad.to_numpy())[0]
-        raise IngestError(
-            f"{path}: line {first_line + row}, column {columns[col]!r}: expected a number, "
-            f"got {stripped.iat[row, col]!r}"
-        )
-    return values.to_numpy(dtype=float)

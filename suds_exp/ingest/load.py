@@ -18,11 +18,13 @@ from suds_exp.store.tables import markers, trials
 
 @dataclass(frozen=True)
 class IngestResult:
-    """What happened to one file: ``status`` is ``"ingested"`` or ``"skipped"``."""
+    """What happened to one file: ``status`` is ``"ingested"``, ``"skipped"`` or
+    ``"failed"`` (only with ``keep_going``; then ``trial_id`` is None and ``message`` is
+    the one-line reason)."""
 
     path: Path
     status: str
-    trial_id: int
+    trial_id: int | None
     n_frames: int
     message: str
 
@@ -117,13 +119,14 @@ def ingest_file(
         if condition
         else "no condition"
     )
+    notes = "".join(f"; {note}" for note in capture.meta.get("notes", []))
     return IngestResult(
         path,
         "ingested",
         trial_id,
         capture.n_frames,
         f"{path}: trial {trial_id}, {capture.n_frames} frames, "
-        f"{len(capture.marker_names)} markers ({label})",
+        f"{len(capture.marker_names)} markers ({label}){notes}",
     )
 
 
@@ -133,6 +136,7 @@ def ingest_paths(
     manifest: Path | None = None,
     layout: Path | None = None,
     progress: bool = True,
+    keep_going: bool = False,
 ) -> list[IngestResult]:
     """Ingest capture files and folders, each file in its own transaction.
 
@@ -149,9 +153,12 @@ def ingest_paths(
         CSV ``role,marker`` mapping the capture's marker names to the robot's roles.
     progress : bool
         Show a progress bar when there is more than one file.
+    keep_going : bool
+        Go on past a bad file: its result has status ``"failed"`` and its one-line
+        reason, and nothing of it is stored. Without it, the first bad file stops the run
+        with an `IngestError`. Either way the files stored before stay stored.
 
-    The manifest and layout are checked before any file is read. The first bad file
-    stops the run with an `IngestError`; files before it stay ingested.
+    The manifest and layout are checked before any file is read.
     """
     conditions = read_manifest(manifest) if manifest is not None else {}
     roles = read_layout(layout) if layout is not None else None
@@ -166,6 +173,11 @@ def ingest_paths(
     with bar as advance, store.writer() as conn:
         for path in files:
             condition = conditions.get(Path(path).resolve())
-            results.append(ingest_file(store, path, condition, roles, source, conn))
+            try:
+                results.append(ingest_file(store, path, condition, roles, source, conn))
+            except IngestError as exc:
+                if not keep_going:
+                    raise
+                results.append(IngestResult(Path(path), "failed", None, 0, str(exc)))
             advance()
     return results

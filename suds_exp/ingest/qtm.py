@@ -1,22 +1,20 @@
 """Reader for Qualisys Track Manager (QTM) 3D TSV exports.
 
 Layout: ``KEY<TAB>value...`` header lines (NO_OF_FRAMES, NO_OF_MARKERS, FREQUENCY,
-MARKER_NAMES, TRAJECTORY_TYPES, ...), then a column line
-``Frame Time <name> X <name> Y <name> Z ...`` and one line per frame. QTM writes a
-marker it did not see as ``0 0 0`` (or leaves the cells empty when gap filling is off);
-both are read as missing. Line ends may be CRLF; a trailing tab is allowed.
+MARKER_NAMES, TRAJECTORY_TYPES, TIME_STAMP, EVENT, ...; any upper-case key is accepted),
+then a column line ``Frame Time <name> X <name> Y <name> Z ...`` and one line per frame,
+numbered from any first frame. QTM writes a marker it did not see as ``0 0 0``, as
+``NA`` or ``NaN``, or leaves the cells empty; all are read as missing. Line ends may be
+CRLF; a trailing tab is allowed.
 """
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-
 from suds_exp.errors import IngestError
-from suds_exp.ingest.capture import Capture, parse_numeric_block
+from suds_exp.ingest.capture import Capture
+from suds_exp.ingest.marker_table import MarkerTable, parse_rate, read_marker_table
 
 _REQUIRED = ("NO_OF_FRAMES", "NO_OF_MARKERS", "FREQUENCY", "MARKER_NAMES")
 
@@ -59,14 +57,9 @@ def read_qtm_tsv(path: Path, text: str) -> Capture:
 
     n_frames = _header_int(path, header, "NO_OF_FRAMES", header_line["NO_OF_FRAMES"])
     n_markers = _header_int(path, header, "NO_OF_MARKERS", header_line["NO_OF_MARKERS"])
-    try:
-        rate = float(header["FREQUENCY"][0])
-    except (ValueError, IndexError):
-        rate = float("nan")
-    if not np.isfinite(rate) or rate <= 0:
-        raise IngestError(
-            f"{path}: line {header_line['FREQUENCY']}, FREQUENCY: expected a positive number of Hz"
-        )
+    rate = parse_rate(
+        path, (header["FREQUENCY"] or [""])[0], f"line {header_line['FREQUENCY']}, FREQUENCY"
+    )
     names = [n.strip() for n in header["MARKER_NAMES"]]
     if len(names) != n_markers:
         raise IngestError(
@@ -80,61 +73,19 @@ def read_qtm_tsv(path: Path, text: str) -> Capture:
             f"{path}: line {table_at + 1}: expected columns 'Frame Time' then "
             f"'<name> X/Y/Z' for the {n_markers} markers of MARKER_NAMES"
         )
-    body = lines[table_at + 1 :]
-    while body and not body[-1].strip():
-        body.pop()
-    if len(body) != n_frames:
-        raise IngestError(
-            f"{path}: NO_OF_FRAMES says {n_frames} but the file has {len(body)} data lines"
-            + (" (truncated?)" if len(body) < n_frames else "")
-        )
-    n_cols = len(expected)
-    # A well-formed line has n_cols cells, plus an empty one after a trailing tab.
-    tabs = np.fromiter((line.count("\t") for line in body), dtype=np.int64, count=len(body))
-    trailing = np.fromiter((line.endswith("\t") for line in body), dtype=bool, count=len(body))
-    wrong = (tabs < n_cols - 1) | (tabs > n_cols) | ((tabs == n_cols) & ~trailing)
-    if wrong.any():
-        row = int(np.flatnonzero(wrong)[0])
-        raise IngestError(
-            f"{path}: line {table_at + 2 + row}: expected {n_cols} tab-separated values, "
-            f"got {tabs[row] + 1 - int(trailing[row])}"
-        )
-    values = _parse_floats(path, body, n_cols, table_at + 2, expected)
-    xyz = values[:, 2:].reshape(len(body), n_markers, 3)
-    # QTM exports an unseen marker as exactly 0 0 0.
-    unseen = np.all(xyz == 0.0, axis=2)
-    xyz[unseen] = np.nan
-    frame = values[:, 0]
-    if np.any(np.isnan(frame)) or np.any(frame != np.round(frame)):
-        row = int(np.flatnonzero(np.isnan(frame) | (frame != np.round(frame)))[0])
-        raise IngestError(
-            f"{path}: line {table_at + 2 + row}, column 'Frame': expected a whole number"
-        )
-    return Capture(
-        path=path,
+    table = MarkerTable(
         format="qtm-tsv",
-        sample_rate_hz=rate,
-        marker_names=names,
-        frame=frame.astype(np.int64),
-        t=values[:, 1],
-        xyz=xyz,
+        lines=lines,
+        start=table_at + 1,
+        stop=len(lines),
+        sep="\t",
+        columns=expected,
+        names=names,
+        xyz_columns=list(range(2, len(expected), 3)),
+        rate_hz=rate,
+        # QTM exports an unseen marker as exactly 0 0 0 (or NA, or empty cells).
+        zero_is_missing=True,
+        declared_frames=(n_frames, "NO_OF_FRAMES"),
         meta={"trajectory_types": header.get("TRAJECTORY_TYPES", [])},
-        first_line=table_at + 2,
     )
-
-
-def _parse_floats(
-    path: Path, body: list[str], n_cols: int, first_line: int, columns: list[str]
-) -> np.ndarray:
-    """The data lines as floats, shape (n_lines, n_cols); empty cells become NaN."""
-    text = "\n".join(line[:-1] if line.endswith("\t") else line for line in body)
-    options = dict(sep="\t", header=None, names=range(n_cols), engine="c")
-    try:
-        # Fast path: the C parser converts straight to float.
-        return pd.read_csv(
-            io.StringIO(text), dtype=float, na_values=[""], keep_default_na=False, **options
-        ).to_numpy()
-    except (ValueError, pd.errors.ParserError):
-        pass  # some cell is not a number: find and name it below
-    cells = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False, **options)
-    return parse_numeric_block(path, cells.fillna(""), first_line, columns)
+    return read_marker_table(path, table)

@@ -10,7 +10,10 @@ from suds_exp.errors import IngestError
 from suds_exp.ingest.c3d_reader import read_c3d
 from suds_exp.ingest.capture import Capture
 from suds_exp.ingest.csv_reader import read_marker_csv
+from suds_exp.ingest.motive import is_motive_csv, read_motive_csv
 from suds_exp.ingest.qtm import read_qtm_tsv
+from suds_exp.ingest.trc import read_trc
+from suds_exp.ingest.vicon import is_vicon_csv, read_vicon_csv
 
 
 def _text(data: bytes) -> str:
@@ -21,11 +24,22 @@ def _text(data: bytes) -> str:
         return data.decode("latin-1")
 
 
+def _read_any_csv(path: Path, data: bytes) -> Capture:
+    """A ``.csv`` is a Vicon Nexus or Motive export by its first line, else our layout."""
+    text = _text(data)
+    if is_vicon_csv(text):
+        return read_vicon_csv(path, text)
+    if is_motive_csv(text):
+        return read_motive_csv(path, text)
+    return read_marker_csv(path, text)
+
+
 #: extension -> (format name, reader of the file's bytes)
 READERS: dict[str, tuple[str, Callable[[Path, bytes], Capture]]] = {
     ".tsv": ("qtm-tsv", lambda p, b: read_qtm_tsv(p, _text(b))),
     ".c3d": ("c3d", read_c3d),
-    ".csv": ("csv", lambda p, b: read_marker_csv(p, _text(b))),
+    ".csv": ("csv, vicon-csv or motive-csv", _read_any_csv),
+    ".trc": ("trc", lambda p, b: read_trc(p, _text(b))),
 }
 
 
