@@ -77,22 +77,46 @@ def ingest(
     json_: JsonOption = False,
     quiet: QuietOption = False,
 ) -> None:
-    """Ingest QTM TSV exports, C3D files or marker CSVs (each file in one transaction).
+    """Ingest QTM TSV, C3D, Vicon Nexus / Motive / marker CSV and TRC files.
 
-    Example: suds-exp ingest data/ --manifest data/manifest.csv
+    Each file is one transaction; a bad file is reported in one line and the others are
+    still stored (exit status 2 at the end). Example: suds-exp ingest data/ --manifest
+    data/manifest.csv
     """
     from suds_exp.ingest import ingest_paths
 
     results = ingest_paths(
-        open_store(db), paths or [], manifest, layout, progress=not (quiet or json_)
+        open_store(db),
+        paths or [],
+        manifest,
+        layout,
+        progress=not (quiet or json_),
+        keep_going=True,
     )
+    failed = [r for r in results if r.status == "failed"]
     if json_:
         console.print_json(
-            [{"file": str(r.path), "status": r.status, "trial_id": r.trial_id} for r in results]
+            [
+                {"file": str(r.path), "status": r.status, "trial_id": r.trial_id}
+                | ({"error": r.message} if r.status == "failed" else {})
+                for r in results
+            ]
         )
-        return
-    for r in results:
-        console.out.print(("ingested " if r.status == "ingested" else "skipped ") + r.message)
+    else:
+        for r in results:
+            if r.status != "failed":
+                console.out.print(f"{r.status} {r.message}")
+    for r in failed:
+        console.err.print(f"[red]error:[/red] {r.message}", markup=True, highlight=False)
+    if failed and len(results) > 1:
+        console.err.print(
+            f"[red]error:[/red] {len(failed)} of {len(results)} files refused; "
+            "the others are stored",
+            markup=True,
+            highlight=False,
+        )
+    if failed:
+        raise typer.Exit(2)
 
 
 @command()
@@ -242,6 +266,10 @@ def preprocess(
         str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 (default: all).")
     ] = None,
     list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
+    body: Annotated[
+        str | None,
+        typer.Option(help="Body description: a TOML file, or 'swimmer' (the default body)."),
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -249,7 +277,8 @@ def preprocess(
     """Turn markers into samples (shape, phase, body velocity) as a stored version.
 
     The same parameters are the same version: re-running skips the trials already done.
-    Example: suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-20
+    Example: suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-20;
+    suds-exp preprocess --body snake.toml (a marker chain: shape modes of chord angles)
     """
     from suds_exp.preprocess import list_versions, parse_param_items, parse_trial_ids
     from suds_exp.preprocess import preprocess as run_preprocess
@@ -263,13 +292,25 @@ def preprocess(
             shown = frame.drop(columns=["params"]).assign(params_hash=frame.params_hash.str[:12])
             console.print_frame(shown, title="preprocessing versions")
         return
-    result = run_preprocess(
-        store,
-        name,
-        parse_param_items(param or []),
-        parse_trial_ids(trials_),
-        progress=not (quiet or json_),
-    )
+    if body is not None:
+        from suds_exp.body import load_body, preprocess_body
+
+        result = preprocess_body(
+            store,
+            load_body(body),
+            name,
+            parse_param_items(param or []),
+            parse_trial_ids(trials_),
+            progress=not (quiet or json_),
+        )
+    else:
+        result = run_preprocess(
+            store,
+            name,
+            parse_param_items(param or []),
+            parse_trial_ids(trials_),
+            progress=not (quiet or json_),
+        )
     if json_:
         console.print_json(result.to_dict())
         return
@@ -278,7 +319,8 @@ def preprocess(
         f"version {result.version_id} ({result.name}, params {result.params_hash[:12]}): "
         f"{'created' if result.created else 'reused'}; processed {len(result.processed)} "
         f"trials ({result.n_samples} samples), skipped {len(result.skipped)} already done, "
-        f"in {result.seconds:.1f} s; passive PCs explain {ev}"
+        f"in {result.seconds:.1f} s; "
+        f"{'shape modes' if 'body' in result.params else 'passive PCs'} explain {ev}"
     )
 
 
