@@ -1,0 +1,292 @@
+"""`preprocess_body`: preprocessing driven by a body description.
+
+The swimmer's description runs the standard pipeline (`suds_exp.preprocess.preprocess`)
+unchanged. A chain description (snake, fish) gives a version whose samples hold:
+
+- ``ra_1, ra_2``: the first two shape modes (rad; PCA of the chord angles, fitted on the
+  version's trials), the driven travelling wave whose phase Phaser estimates;
+- ``rp_1..rp_k``: the next k = modes - 2 shape modes (rad, not passive states: a chain
+  body is actuated all along), and their rates ``drp_*`` (rad/s);
+- ``vx, vy, wz``: velocity of the chain's frame (centroid, mean chord heading).
+
+The version's parameters are the usual ones plus the description (``body``), so another
+description is another version, and re-running skips the trials already done.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import sqlalchemy as sa
+
+from suds_exp.body.chain_shape import chain_geometry
+from suds_exp.body.description import Body, BodyError, check_markers
+from suds_exp.preprocess.clean import clean_tracks
+from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.preprocess.params import params_hash, params_json, resolve_params
+from suds_exp.preprocess.phaser import Phaser, cycles
+from suds_exp.preprocess.pipeline import PrepResult, preprocess
+from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
+from suds_exp.preprocess.shape import PassivePCA
+from suds_exp.preprocess.tables import (
+    DRP_COLUMNS,
+    RP_COLUMNS,
+    prep_fits,
+    prep_pca,
+    prep_trials,
+    prep_versions,
+)
+from suds_exp.progress import progress_bar
+from suds_exp.store import Store
+from suds_exp.store.tables import trials
+
+
+def preprocess_body(
+    store: Store,
+    body: Body,
+    name: str | None = None,
+    params: Mapping[str, Any] | None = None,
+    trials: Iterable[int] | None = None,
+    progress: bool = True,
+) -> PrepResult:
+    """Preprocess trials of ``body``: the standard pipeline for the swimmer, else a chain.
+
+    Parameters as `suds_exp.preprocess.preprocess`; ``params["k"]`` is set from the
+    chain's ``modes`` (k = modes - 2). Raises `BodyError` for a description the trials do
+    not fit (an unknown marker) or a segment body other than the swimmer (not supported
+    yet), `PreprocessError` as the standard pipeline does.
+    """
+    if body.is_swimmer():
+        return preprocess(store, name, params, trials, progress)
+    if body.chain is None:
+        raise BodyError(
+            f"{body.source}: segment bodies other than the swimmer's (11 roles, motors at "
+            "the middle segment's ends) are not preprocessed yet; describe a continuous "
+            "body as a [chain]"
+        )
+    return _preprocess_chain(store, body, name, params, trials, progress)
+
+
+def _chain_tracks(conn: sa.Connection, body: Body, meta_row) -> tuple[np.ndarray, ...]:
+    names = body.chain.markers
+    df = Store.frame(
+        conn,
+        "SELECT frame, t, list_position($names, marker) - 1 AS k, x, y, z FROM markers "
+        "WHERE trial_id = $tid AND list_contains($names, marker) ORDER BY frame, k",
+        {"names": list(names), "tid": int(meta_row.id)},
+    )
+    frames, inverse = np.unique(df.frame.to_numpy(), return_inverse=True)
+    xyz = np.full((len(frames), len(names), 3), np.nan)
+    xyz[inverse, df.k.to_numpy()] = df[["x", "y", "z"]].to_numpy(dtype=float)
+    t = np.zeros(len(frames))
+    t[inverse] = df.t.to_numpy()
+    return frames, t, xyz
+
+
+def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResult:
+    started = time.perf_counter()
+    given = dict(params or {})
+    given["k"] = body.chain.modes - 2
+    params = resolve_params(given)
+    params["body"] = body.to_dict()
+    digest = params_hash(params)
+    wanted = None if trials_ is None else sorted({int(i) for i in trials_})
+    v = prep_versions.c
+    with store.write() as conn:
+        row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
+        if name is not None:
+            clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
+            if clash is not None and clash.params_hash != digest:
+                raise PreprocessError(
+                    f"--name {name}: version {clash.id} already has that name with other "
+                    "parameters; choose another name"
+                )
+        query = sa.select(
+            trials.c.id, trials.c.source_file, trials.c.sample_rate_hz, trials.c.marker_names
+        ).order_by(trials.c.id)
+        meta = Store.frame(conn, query)
+        if wanted is not None:
+            unknown = sorted(set(wanted) - {int(i) for i in meta.id})
+            if unknown:
+                raise PreprocessError(f"--trials: no trial with id {', '.join(map(str, unknown))}")
+            meta = meta[meta.id.isin(wanted)]
+        if meta.empty:
+            raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+        done: set[int] = set()
+        fits: dict[tuple[str, str], str] = {}
+        if row is not None:
+            done = {
+                int(r[0])
+                for r in conn.execute(
+                    sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == row.id)
+                )
+            }
+            fits = {
+                (r.kind, r.grp): r.state
+                for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == row.id))
+            }
+        todo = meta[~meta.id.isin(done)]
+        for r in todo.itertuples(index=False):
+            check_markers(body, list(r.marker_names), f"trial {r.id} ({r.source_file})")
+        raw = {int(r.id): _chain_tracks(conn, body, r) for r in todo.itertuples(index=False)}
+    result = PrepResult(
+        version_id=row.id if row is not None else -1,
+        name=row.name if row is not None else (name or ""),
+        params_hash=digest,
+        params=params,
+        created=row is None,
+        skipped=sorted(int(i) for i in meta.id if int(i) in done),
+    )
+    if todo.empty:
+        result.seconds = time.perf_counter() - started
+        return result
+
+    items = []
+    for r in todo.itertuples(index=False):
+        frames, t, xyz = raw[int(r.id)]
+        rate = float(r.sample_rate_hz)
+        label = f"trial {r.id} ({r.source_file})"
+        if len(frames) < 8:
+            raise PreprocessError(f"{label}: only {len(frames)} frames; need at least 8")
+        max_gap = int(np.floor(params["max_gap_s"] * rate + 1e-9))
+        try:
+            clean = clean_tracks(xyz, params["jump_mm"], max_gap, body.chain.markers)
+        except PreprocessError as exc:
+            raise PreprocessError(f"{label}: {exc}") from None
+        items.append((int(r.id), rate, frames, t, clean, chain_geometry(clean.xyz, body.chain.up)))
+
+    new_fits = []
+    if ("pca", "") in fits:
+        pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
+    else:
+        pca = PassivePCA(body.chain.modes).fit(np.concatenate([g.angles for *_, g in items]))
+        new_fits.append(("pca", "", json.dumps(pca.to_dict()), [i[0] for i in items]))
+    phasers = {}
+    for tid, *_, geom in items:
+        group = f"trial:{tid}"
+        if ("phaser", group) in fits:
+            phasers[tid] = Phaser.from_dict(json.loads(fits[("phaser", group)]))
+            continue
+        try:
+            phasers[tid] = Phaser(params["phaser_order"], params["phaser_pad_cycles"]).fit(
+                [pca.transform(geom.angles)[:, :2]]
+            )
+        except PreprocessError as exc:
+            raise PreprocessError(f"phase of trial {tid}: {exc}") from None
+        new_fits.append(("phaser", group, json.dumps(phasers[tid].to_dict()), [tid]))
+
+    with store.write() as conn:
+        if row is None:
+            vid = int(conn.exec_driver_sql("SELECT nextval('prep_versions_id_seq')").scalar_one())
+            result.name = name or f"v{vid}"
+            conn.execute(
+                sa.insert(prep_versions).values(
+                    id=vid,
+                    name=result.name,
+                    params_hash=digest,
+                    params=params_json(params),
+                    k=params["k"],
+                    created_at=sa.func.current_timestamp(),
+                )
+            )
+            result.version_id = vid
+        vid = result.version_id
+        now = pd.Timestamp.now(tz="UTC").tz_localize(None)
+        if new_fits:
+            n_frames = {i[0]: len(i[2]) for i in items}
+            store.insert_df(
+                conn,
+                prep_fits.name,
+                pd.DataFrame(
+                    [
+                        {
+                            "version_id": vid,
+                            "kind": kind,
+                            "grp": grp,
+                            "state": state,
+                            "trial_ids": ids,
+                            "n_frames": int(sum(n_frames[i] for i in ids)),
+                            "fitted_at": now,
+                        }
+                        for kind, grp, state, ids in new_fits
+                    ]
+                ),
+            )
+        if any(kind == "pca" for kind, *_ in new_fits):
+            cum = np.cumsum(pca.explained_variance_ratio_)
+            store.insert_df(
+                conn,
+                prep_pca.name,
+                pd.DataFrame(
+                    {
+                        "version_id": vid,
+                        "component": np.arange(1, len(cum) + 1),
+                        "explained_variance": pca.explained_variance_,
+                        "explained_variance_ratio": pca.explained_variance_ratio_,
+                        "cumulative_ratio": cum,
+                        "kept": np.arange(len(cum)) < body.chain.modes,
+                        "loadings": [list(r) for r in pca.components_],
+                    }
+                ),
+            )
+
+    with progress_bar("Preprocessing", total=len(items), enabled=progress, unit="trials") as adv:
+        for tid, rate, frames, t, clean, geom in items:
+            samples = chain_samples(vid, tid, rate, frames, t, geom, pca, phasers[tid], params)
+            stats = {
+                "version_id": vid,
+                "trial_id": tid,
+                "n_frames": len(t),
+                "n_jumps": clean.n_jumps,
+                "removed_fraction": clean.removed_fraction,
+                "filled_fraction": clean.filled_fraction,
+                "longest_gap_frames": clean.longest_gap,
+                "plane_normal": [float(a == body.chain.up) for a in "xyz"],
+                "middle_length_mm": float(geom.length.mean()),
+                "joint_rms_mm": float(geom.length.std()),
+                "phaser_group": f"trial:{tid}",
+                "done_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
+            }
+            with store.write() as conn:
+                store.insert_df(conn, "samples", samples)
+                store.insert_df(conn, prep_trials.name, pd.DataFrame([stats]))
+            result.processed.append(tid)
+            result.n_samples += len(samples)
+            adv()
+    result.explained_variance_ratio = pca.explained_variance_ratio_[: body.chain.modes].tolist()
+    result.seconds = time.perf_counter() - started
+    return result
+
+
+def chain_samples(vid, tid, rate, frames, t, geom, pca, phaser, params) -> pd.DataFrame:
+    """The samples rows of one chain trial (columns of the ``samples`` table)."""
+    dt = 1.0 / rate
+    w = differentiator_window(params, rate, None, len(t))
+    po, kernel = params["sg_polyorder"], params["sg_kernel"]
+    modes = pca.transform(geom.angles)
+    rates = pca.transform_rate(derivative(geom.angles, dt, w, po, kernel))
+    vb = body_velocity(geom.origin, geom.heading, dt, w, po, kernel)
+    phase = phaser.transform(modes[:, :2])
+    n, k = len(t), params["k"]
+    cols: dict[str, Any] = {
+        "version_id": np.full(n, vid, dtype=np.int32),
+        "trial_id": np.full(n, tid, dtype=np.int32),
+        "frame": np.asarray(frames, dtype=np.int32),
+        "t": t,
+        "phase": phase,
+        "cycle": cycles(phase).astype(np.int32),
+        "ra_1": modes[:, 0],
+        "ra_2": modes[:, 1],
+        "dra_1": rates[:, 0],
+        "dra_2": rates[:, 1],
+    }
+    for i in range(len(RP_COLUMNS)):
+        cols[RP_COLUMNS[i]] = modes[:, 2 + i] if i < k else np.full(n, np.nan)
+        cols[DRP_COLUMNS[i]] = rates[:, 2 + i] if i < k else np.full(n, np.nan)
+    cols.update(vx=vb[:, 0], vy=vb[:, 1], wz=vb[:, 2])
+    return pd.DataFrame(cols)
