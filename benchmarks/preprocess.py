@@ -3,7 +3,7 @@ errors against the simulator's truth.
 
 Usage::
 
-    .venv/bin/python benchmarks/preprocess.py [--db FILE] [--repeats 3] [--json]
+    .venv/bin/python benchmarks/preprocess.py [--db FILE] [--repeats 3] [--json] [--body FILE]
 
 Data: the default design of `suds-exp simulate` (5 gaits x 3 frequencies x 4 repeats,
 10-30 cycles, seed 0: 60 trials, about 240k frames at 100 Hz), simulated into a temporary
@@ -35,6 +35,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from suds_exp.body import load_body, preprocess_body  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
 from suds_exp.preprocess.truth import truth_errors  # noqa: E402
 from suds_exp.sim.commands import simulate_command  # noqa: E402
@@ -46,6 +47,9 @@ def main() -> None:
     parser.add_argument("--db", type=Path, help="Database already holding the dataset.")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--json", action="store_true")
+    parser.add_argument(
+        "--body", help="Preprocess through this body description (e.g. swimmer) instead."
+    )
     args = parser.parse_args()
 
     with tempfile.TemporaryDirectory(prefix="suds-prep-bench-") as tmp:
@@ -62,7 +66,10 @@ def main() -> None:
             shutil.copyfile(source, copy)
             store = Store(copy)
             started = time.perf_counter()
-            result = preprocess(store, progress=False)
+            if args.body:
+                result = preprocess_body(store, load_body(args.body), progress=False)
+            else:
+                result = preprocess(store, progress=False)
             runs.append(time.perf_counter() - started)
         errors = truth_errors(Store(copy), result.version_id).set_index("trial_id").loc[-1]
     rms_vx = float(errors.rms_vx_true)
