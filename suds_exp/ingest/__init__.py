@@ -1,4 +1,5 @@
-"""Mocap ingest: QTM TSV, C3D and CSV readers, manifest, marker layout."""
+"""Mocap ingest: QTM TSV, Vicon Nexus CSV, Motive CSV, TRC, C3D and CSV readers sharing
+one parsing core, manifest, marker layout."""
 
 from suds_exp.ingest.capture import Capture
 from suds_exp.ingest.layout import DEFAULT_LAYOUT, ROLES, read_layout, trial_layout

@@ -20,7 +20,7 @@ class Capture:
     path : Path
         The file it was read from.
     format : str
-        ``"qtm-tsv"``, ``"c3d"`` or ``"csv"``.
+        ``"qtm-tsv"``, ``"c3d"``, ``"csv"``, ``"vicon-csv"``, ``"motive-csv"`` or ``"trc"``.
     sample_rate_hz : float
         Capture rate, Hz.
     marker_names : list of str

@@ -144,7 +144,8 @@ def ingest_paths(
     ----------
     store : Store
     paths : list of Path
-        Capture files (``.tsv`` QTM export, ``.c3d``, ``.csv``) or folders to search.
+        Capture files (``.tsv`` QTM export, ``.c3d``, ``.csv`` marker, Vicon Nexus or
+        Motive export, ``.trc``) or folders to search.
         When empty, the files the manifest lists are ingested.
     manifest : Path, optional
         CSV ``file,gait,frequency_hz,repeat,notes`` assigning conditions; a file with no
