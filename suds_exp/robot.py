@@ -110,7 +110,7 @@ def parse_frequency(text: str) -> float:
     return value
 
 
-def parse_ids(text: str | None, option: str = "--trials") -> list[int] | None:
+def parse_ids(text: str | None, option: str = "trials") -> list[int] | None:
     """``"1,2,5-8"`` -> [1, 2, 5, 6, 7, 8] (sorted, unique, each >= 1); None or blank ->
     None (all). ``option`` names the parameter in the error (ConfigError)."""
     if text is None or not str(text).strip():
@@ -125,11 +125,15 @@ def parse_ids(text: str | None, option: str = "--trials") -> list[int] | None:
             first, last = int(lo), int(hi) if sep else int(lo)
         except ValueError:
             raise ConfigError(
-                f"{option} {text!r}: expected ids and ranges such as 1,2,5-8"
+                f"{option} {text!r}: expected ids and ranges such as 1,2,5-8", param=option
             ) from None
         if first < 1 or last < first:
-            raise ConfigError(f"{option} {text!r}: {part!r} is not a valid id or range")
+            raise ConfigError(
+                f"{option} {text!r}: {part!r} is not a valid id or range", param=option
+            )
         ids.update(range(first, last + 1))
     if not ids:
-        raise ConfigError(f"{option} {text!r}: expected ids and ranges such as 1,2,5-8")
+        raise ConfigError(
+            f"{option} {text!r}: expected ids and ranges such as 1,2,5-8", param=option
+        )
     return sorted(ids)
