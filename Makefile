@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow browser lint clean
+.PHONY: demo test test-slow browser lint lint-imports clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -31,6 +31,10 @@ browser:
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
+
+# the layering contracts in pyproject.toml ([tool.importlinter])
+lint-imports: $(STAMP)
+	$(BIN)/lint-imports
 
 clean:
 	rm -rf $(VENV) *.duckdb reports/*/ sim-data

@@ -35,6 +35,19 @@ JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON documen
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 
 
+#: Library parameters whose flag is not simply ``--`` + the name with dashes.
+FLAGS: dict[str, str] = {}
+
+
+def user_message(exc: SudsError) -> str:
+    """The error's one line in the CLI's words: a leading Python parameter name (the
+    error's ``param``) becomes its flag."""
+    text, param = str(exc), getattr(exc, "param", None)
+    if not param or param.startswith("-") or not text.startswith(param):
+        return text
+    return FLAGS.get(param, "--" + param.replace("_", "-")) + text[len(param) :]
+
+
 def command(*args, **kwargs):
     """`app.command` that turns a `SudsError` into one line on stderr and exit code 2."""
 
@@ -44,7 +57,9 @@ def command(*args, **kwargs):
             try:
                 return fn(*a, **kw)
             except SudsError as exc:
-                console.err.print(f"[red]error:[/red] {exc}", markup=True, highlight=False)
+                console.err.print(
+                    f"[red]error:[/red] {user_message(exc)}", markup=True, highlight=False
+                )
                 raise typer.Exit(2) from None
 
         return app.command(*args, **kwargs)(run)

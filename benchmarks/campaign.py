@@ -64,10 +64,10 @@ from suds_exp.campaign.job import RESULT_COLUMNS  # noqa: E402
 from suds_exp.campaign.sampling import draw_sample  # noqa: E402
 from suds_exp.models import make_model  # noqa: E402
 from suds_exp.models.synthetic import make_samples  # noqa: E402
+from suds_exp.robot import FREQUENCIES_HZ as FREQS  # noqa: E402
+from suds_exp.robot import GAITS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
-GAITS = ("S+", "S-", "O", "D-", "D+")
-FREQS = (1 / 3, 1 / 2, 1.0)
 SMALL = "O@1/3,O@1,D+@0.5,S-@1"
 BOOTS = 3
 CYCLES = 30

@@ -24,6 +24,7 @@ import pandas as pd
 
 from suds_exp.discrepancy import draw_hidden, hidden_effect_run
 from suds_exp.discrepancy.demo import HIDDEN
+from suds_exp.robot import GAITS
 
 DESIGN = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
 
@@ -71,7 +72,7 @@ def default_timing(seed: int = 0) -> dict:
     hidden = {"body_inertia": draw_hidden("body_inertia", rng)}
     cpu = time.process_time()
     run = hidden_effect_run(
-        hidden, seed=seed, gaits=("S+", "S-", "O", "D-", "D+"), repeats=4, cycles=(10, 30)
+        hidden, seed=seed, gaits=GAITS, repeats=4, cycles=(10, 30)
     )
     return {
         "hidden": hidden,

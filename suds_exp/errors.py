@@ -7,7 +7,15 @@ expected; the CLI prints it and exits with status 2 without a traceback.
 
 
 class SudsError(Exception):
-    """Base class of every user-facing error in suds-exp."""
+    """Base class of every user-facing error in suds-exp.
+
+    ``param`` names the Python parameter the error is about, when the message starts
+    with it; the CLI then shows that parameter's flag instead (``trials`` -> ``--trials``).
+    """
+
+    def __init__(self, message: str = "", *, param: str | None = None):
+        super().__init__(message)
+        self.param = param
 
 
 class IngestError(SudsError):

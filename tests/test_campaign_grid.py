@@ -9,8 +9,7 @@ import pytest
 from suds_exp.campaign import CampaignError, Draw, SampleBank, enumerate_draws, parse_int_list
 from suds_exp.campaign.conditions import select_conditions
 from suds_exp.campaign.sampling import draw_sample
-
-GAIT_K = {"S+": -4.0, "S-": -9.0, "O": np.inf, "D-": 9.0, "D+": 4.0}
+from suds_exp.robot import GAIT_K
 
 
 def synthetic_samples(

@@ -135,11 +135,17 @@ def test_cli_run_and_status(db, samples, monkeypatch):
 
     seen = []
 
-    def fake_load(store, version):
-        seen.append(version)
-        return samples
+    class Version:  # a preprocessing version named v1 whose samples are `samples`
+        name = "v1"
 
-    monkeypatch.setattr(preprocess, "load_samples", fake_load, raising=False)
+        def samples(self, trials=None):
+            return samples
+
+    def fake_get_version(store, ref=None):
+        seen.append(ref)
+        return Version()
+
+    monkeypatch.setattr(preprocess, "get_version", fake_get_version)
     runner = CliRunner()
     args = [
         "run",

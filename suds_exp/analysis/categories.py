@@ -10,11 +10,11 @@ from __future__ import annotations
 import pandas as pd
 
 from suds_exp.analysis.errors import AnalysisError
+from suds_exp.robot import GAITS, LEARNERS
 
 #: The gait axis; gait similarity is the number of steps along it (0 same, 1 near, >1 far).
-GAIT_AXIS = ("S+", "S-", "O", "D-", "D+")
-#: Learners in display order; unknown names are shown after these, sorted.
-LEARNERS = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
+GAIT_AXIS = GAITS
+#: Learners in display order (`LEARNERS`); unknown names are shown after these, sorted.
 #: Category orders as the paper's panels run, left to right.
 FREQ_SIM = ("different", "same")
 GAIT_SIM = ("far", "near", "same")

@@ -15,8 +15,7 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.analysis.categories import GAIT_AXIS, LEARNERS
-
-FREQUENCIES_HZ = (1 / 3, 1 / 2, 1.0)
+from suds_exp.robot import FREQUENCIES_HZ
 
 #: The paper's first-order-interactions GLM (its Table "GLM coefficient comparison"), used
 #: as the default truth so a synthetic report can be read beside the paper's.

@@ -28,9 +28,8 @@ import pandas as pd
 
 from suds_exp.campaign.conditions import Condition, condition_sort_key, format_condition, round_hz
 from suds_exp.campaign.errors import CampaignError
+from suds_exp.robot import SAMPLE_KEYS, VB_COLUMNS
 
-_BASE = ("trial_id", "frame", "t", "phase", "cycle", "ra_1", "ra_2", "dra_1", "dra_2")
-_VB = ("vx", "vy", "wz")
 _RP = re.compile(r"^d?rp_\d+$")
 _TWO_PI = 2.0 * np.pi
 #: A cycle is complete when its samples span 2 pi less at most this many phase steps.
@@ -39,14 +38,14 @@ COMPLETE_SLACK_STEPS = 2.5
 
 def sample_columns(samples: pd.DataFrame) -> list[str]:
     """The standard numeric sample columns present in ``samples``, in contract order."""
-    missing = [c for c in (*_BASE, *_VB) if c not in samples.columns]
+    missing = [c for c in (*SAMPLE_KEYS, *VB_COLUMNS) if c not in samples.columns]
     if missing:
         raise CampaignError(
             f"samples frame lacks column(s) {', '.join(missing)}; expected the columns of "
             "the `samples` table (see DESIGN.md)"
         )
     rp = sorted((c for c in samples.columns if _RP.match(str(c))), key=lambda c: (c[0] == "d", c))
-    return [*_BASE, *rp, *_VB]
+    return [*SAMPLE_KEYS, *rp, *VB_COLUMNS]
 
 
 @dataclass(frozen=True)

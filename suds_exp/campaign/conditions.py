@@ -8,12 +8,9 @@ frequency present) or ``@FREQ`` (every gait at that frequency); FREQ may be a fr
 
 from __future__ import annotations
 
-from fractions import Fraction
-
 from suds_exp.campaign.errors import CampaignError
-
-#: The gait axis of the paper, in order.
-GAITS = ("S+", "S-", "O", "D-", "D+")
+from suds_exp.errors import ConfigError
+from suds_exp.robot import GAITS, parse_frequency, parse_ids
 
 Condition = tuple[str, float]
 
@@ -35,13 +32,11 @@ def format_condition(cond: Condition) -> str:
 
 def _parse_hz(text: str, option: str) -> float:
     try:
-        value = float(Fraction(text.strip()))
-    except (ValueError, ZeroDivisionError):
+        value = parse_frequency(text)
+    except ValueError:
         raise CampaignError(
-            f"{option}: frequency {text!r} is not a number; write e.g. 0.5 or 1/3"
+            f"{option}: frequency {text!r} is not a positive number; write e.g. 0.5 or 1/3"
         ) from None
-    if value <= 0:
-        raise CampaignError(f"{option}: frequency {text!r} must be positive")
     return round_hz(value)
 
 
@@ -82,23 +77,10 @@ def parse_int_list(spec: str | None, option: str) -> list[int]:
         return []
     if spec.strip() == "paper":
         return list(PAPER_SWEEP)
-    values: set[int] = set()
-    for item in (s.strip() for s in spec.split(",")):
-        if not item:
-            continue
-        lo, dash, hi = item.partition("-")
-        try:
-            if dash:
-                values.update(range(int(lo), int(hi) + 1))
-            else:
-                values.add(int(item))
-        except ValueError:
-            raise CampaignError(
-                f"{option}: {item!r} is not an integer or a range like 1-10"
-            ) from None
-    if not values or min(values) < 1:
-        raise CampaignError(f"{option}: numbers of cycles must be integers >= 1, got {spec!r}")
-    return sorted(values)
+    try:
+        return parse_ids(spec, option)
+    except ConfigError as exc:
+        raise CampaignError(str(exc)) from None
 
 
 #: Training cycles of the paper's sample-efficiency figure.

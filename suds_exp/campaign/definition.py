@@ -23,9 +23,8 @@ from suds_exp.campaign.conditions import (
     select_conditions,
 )
 from suds_exp.campaign.errors import CampaignError
+from suds_exp.robot import LEARNERS
 
-#: The paper's learners, in its order.
-LEARNERS = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
 MODES = ("measured", "rollout")
 DEFINITION_VERSION = 1
 

@@ -8,7 +8,7 @@ from suds_exp.campaign.bank import SampleBank, rounded_conditions
 from suds_exp.campaign.conditions import GAITS, format_condition
 from suds_exp.campaign.definition import LEARNERS, CampaignOptions
 from suds_exp.campaign.errors import CampaignError
-from suds_exp.campaign.runner import RunSummary, _resolve_prep, run_campaign
+from suds_exp.campaign.runner import RunSummary, run_campaign
 from suds_exp.store import Store
 
 #: Gaits the demo prefers, in order: with them the pairs cover every gait similarity
@@ -62,9 +62,9 @@ def demo_campaign(
 ) -> RunSummary:
     """Run (or finish) the demo campaign on preprocessing version ``prep`` (None: the
     only one); about 480 jobs, a minute or two on 2 cores. Returns the `RunSummary`."""
-    from suds_exp.preprocess import load_samples
+    from suds_exp.preprocess import get_version
 
-    prep = _resolve_prep(store, prep)
-    samples = load_samples(store, prep)
+    version = get_version(store, prep)
+    prep, samples = version.name, version.samples()
     options = demo_options(samples, prep)
     return run_campaign(store, name, options, samples=samples, jobs=jobs, progress=progress)

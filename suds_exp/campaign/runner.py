@@ -235,10 +235,10 @@ def run_campaign(
         stored = load_stored_definition(store, name)
         options = merge_stored(options, stored)
         if samples is None:
-            from suds_exp.preprocess import load_samples
+            from suds_exp.preprocess import get_version
 
-            options.prep = _resolve_prep(store, options.prep)
-            samples = load_samples(store, options.prep)
+            version = get_version(store, options.prep)
+            options.prep, samples = version.name, version.samples()
         elif options.prep is None:
             options.prep = "(samples given)"
         plan, bank = make_plan(
@@ -278,24 +278,6 @@ def run_campaign(
             )
     summary.seconds = time.perf_counter() - started
     return summary
-
-
-def _resolve_prep(store: Store, prep: str | None) -> str:
-    """The name of preprocessing version ``prep`` (id or name; None: the only one)."""
-    from suds_exp.preprocess import list_versions
-
-    versions = list_versions(store)
-    names = versions["name"].astype(str).tolist()
-    if prep is None:
-        if len(names) == 1:
-            return names[0]
-        raise CampaignError(
-            "--prep: name the preprocessing version to run on "
-            f"(have: {', '.join(names) or 'none; run `suds-exp preprocess` first'})"
-        )
-    prep = str(prep)
-    by_id = dict(zip(versions["id"].astype(str), names, strict=True))
-    return by_id.get(prep, prep)
 
 
 def _n_workers(jobs: int) -> int:

@@ -16,6 +16,7 @@ import numpy as np
 
 from suds_exp.discrepancy.effects import main_parameter, set_effect
 from suds_exp.discrepancy.workflow import DiscrepancyOptions, DiscrepancyResult, run_discrepancy
+from suds_exp.robot import FREQUENCIES_HZ
 from suds_exp.sim.config import SimConfig
 
 #: Hidden-effect settings for the checks: (effect, fixed settings, drawn parameter).
@@ -119,7 +120,7 @@ def hidden_effect_run(
     model: SimConfig | None = None,
     workdir: str | Path | None = None,
     gaits: Sequence[str] = ("S+", "O", "D+"),
-    frequencies_hz: Sequence[float] = (1 / 3, 1 / 2, 1.0),
+    frequencies_hz: Sequence[float] = FREQUENCIES_HZ,
     repeats: int = 4,
     cycles: tuple[int, int] = (4, 6),
     options: DiscrepancyOptions | None = None,

@@ -12,8 +12,8 @@ A window starts with a warm-up (flipper angles and the body-inertia state forget
 unknown initial values) and is scored after it. To compare like with like, the replay's
 body velocity goes through the same differentiator as the measurement: the simulated
 pose is interpolated back to the capture rate and differentiated with the
-preprocessing version's Savitzky-Golay filter; the replayed r_a is the measured one,
-smoothed by the same filter so marker noise does not drive the physics.
+preprocessing version's own `Differentiator` (`Version.differentiator`, never a copy
+of its settings); the replayed r_a is the measured one.
 
 `medium_compaction` depends on the distance travelled since the start of the trial; a
 window starting after distance d0 (measured, m) is replayed with the exactly equivalent
@@ -23,15 +23,16 @@ every trial at distance 0).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import savgol_filter
 
-from suds_exp.preprocess.rates import derivative
-from suds_exp.preprocess.shape import PASSIVE_ROLES
+from suds_exp.preprocess.params import DEFAULTS
+from suds_exp.preprocess.rates import Differentiator
+from suds_exp.robot import PASSIVE_ROLES
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.markers import (
     MARKER_NAMES,
@@ -64,22 +65,17 @@ class ReplaySettings:
         steps per cycle a 1/3 Hz gait would step every 75 ms, the interpolated pose
         would lose that excitation and a replay with the true spoke gain would look
         worse than one without. 25 ms (8 steps per 5 Hz period) resolves it.
-    sg_window_s, sg_window_cycles, sg_window_exponent, sg_polyorder : float, float, float, int
-        The preprocessing version's local-polynomial differentiator: window in s, or
-        ``sg_window_cycles * T**sg_window_exponent`` s (T the gait period, s) when
-        ``sg_window_cycles`` > 0, and its order.
-    sg_kernel : str
-        Its weights over the window (`suds_exp.preprocess.rates.KERNELS`; ``box`` is
-        Savitzky-Golay).
     solver_tol : float
         Scaled residual tolerance of the simulator's per-step solve during replay.
     ra_smooth_s : float
-        Savitzky-Golay smoothing window (s) applied to the measured r_a before it drives
-        the replay, against marker noise; 0 replays it as measured (the samples' r_a is
-        already smoothed by the preprocessing).
+        Savitzky-Golay smoothing window (s, order `Differentiator.polyorder`) applied to
+        the measured r_a before it drives the replay, against marker noise; 0 replays it
+        as measured (the samples' r_a is already smoothed by the preprocessing).
     shape_window_s, shape_polyorder : float, int
         The preprocessing version's smoothing of the passive state (applied to the
-        replayed passive state too).
+        replayed passive state too; `settings_from_prep` takes them from the version).
+
+    The differentiator is not a setting: `make_windows` takes the version's own.
     """
 
     windows_per_trial: int = 2
@@ -87,15 +83,10 @@ class ReplaySettings:
     warmup_cycles: float = 1.0
     samples_per_cycle: int = 40
     max_step_s: float = 0.025
-    sg_window_s: float = 0.21
-    sg_window_cycles: float = 0.0
-    sg_window_exponent: float = 1.0
-    sg_polyorder: int = 3
-    sg_kernel: str = "box"
     solver_tol: float = 1e-7
     ra_smooth_s: float = 0.0
-    shape_window_s: float = 0.21
-    shape_polyorder: int = 5
+    shape_window_s: float = DEFAULTS["shape_window_s"]
+    shape_polyorder: int = DEFAULTS["shape_polyorder"]
 
 
 @dataclass
@@ -120,7 +111,7 @@ class WindowGroup:
     n_fine: int
     score_from: int
     n_scored: int
-    sg_frames: int
+    diff_frames: int
     ra_fine: np.ndarray | None = None
 
 
@@ -129,13 +120,15 @@ class WindowSet:
     """Replay windows over trials. ``trial_id`` (n_windows,), and groups by frame interval.
 
     ``info`` is a frame with one row per window: trial_id, gait, frequency_hz, t_start,
-    t_rel (window centre over trial length, 0..1).
+    t_rel (window centre over trial length, 0..1). ``differentiator`` is the one that
+    made the measured rates; the replay's rates go through it too.
     """
 
     info: pd.DataFrame
     groups: list[WindowGroup]
     settings: ReplaySettings
     pca: object | None = None
+    differentiator: Differentiator = field(default_factory=lambda: default_differentiator())
 
     @property
     def channels(self) -> tuple[str, ...]:
@@ -171,23 +164,31 @@ class WindowSet:
                     g.n_fine,
                     g.score_from,
                     g.n_scored,
-                    g.sg_frames,
+                    g.diff_frames,
                     None if g.ra_fine is None else g.ra_fine[m],
                 )
             )
-        return WindowSet(self.info[keep].reset_index(drop=True), groups, self.settings, self.pca)
+        return WindowSet(
+            self.info[keep].reset_index(drop=True),
+            groups,
+            self.settings,
+            self.pca,
+            self.differentiator,
+        )
+
+
+def default_differentiator() -> Differentiator:
+    """The differentiator of a version made with the default parameters: what samples
+    given without a store are taken to have been differentiated with."""
+    return Differentiator.from_params(DEFAULTS)
 
 
 def settings_from_prep(params: dict, **overrides) -> ReplaySettings:
-    """Replay settings matching a preprocessing version's parameters (its differentiator)."""
+    """Replay settings matching a preprocessing version's parameters (its smoothing of
+    the passive state)."""
     return ReplaySettings(
-        sg_window_s=float(params.get("sg_window_s", 0.21)),
-        sg_window_cycles=float(params.get("sg_window_cycles", 0.0)),
-        sg_window_exponent=float(params.get("sg_window_exponent", 1.0)),
-        sg_polyorder=int(params.get("sg_polyorder", 3)),
-        sg_kernel=str(params.get("sg_kernel", "box")),
-        shape_window_s=float(params.get("shape_window_s", 0.21)),
-        shape_polyorder=int(params.get("shape_polyorder", 5)),
+        shape_window_s=float(params.get("shape_window_s", DEFAULTS["shape_window_s"])),
+        shape_polyorder=int(params.get("shape_polyorder", DEFAULTS["shape_polyorder"])),
         **overrides,
     )
 
@@ -198,7 +199,10 @@ def _odd_window(window_s: float, dt: float, polyorder: int) -> int:
 
 
 def make_windows(
-    samples: pd.DataFrame, settings: ReplaySettings | None = None, pca=None
+    samples: pd.DataFrame,
+    settings: ReplaySettings | None = None,
+    pca=None,
+    differentiator: Differentiator | None = None,
 ) -> WindowSet:
     """Cut measured trials into replay windows.
 
@@ -213,8 +217,13 @@ def make_windows(
         Samples frame (`suds_exp.preprocess.load_samples`): trial_id, t (s), phase (rad),
         ra_1, ra_2 (rad), vx, vy (mm/s), wz (rad/s), gait, frequency_hz.
     settings : ReplaySettings, optional
+    pca : PassivePCA, optional
+    differentiator : Differentiator, optional
+        The one that made the samples' rates (`Version.differentiator`); None: that of
+        the default preprocessing parameters.
     """
     s = settings or ReplaySettings()
+    diff = differentiator or default_differentiator()
     rows, per_group = [], {}
     for trial_id, tr in samples.sort_values(["trial_id", "t"]).groupby("trial_id", sort=True):
         t = tr["t"].to_numpy(float)
@@ -222,7 +231,8 @@ def make_windows(
             continue
         dt_cap = float(np.median(np.diff(t)))
         freq = tr["frequency_hz"].iloc[0]
-        if freq is None or not np.isfinite(freq) or freq <= 0:
+        known = freq is not None and bool(np.isfinite(freq)) and freq > 0
+        if not known:
             # a capture without a manifest: the gait frequency from its phase
             ph = tr["phase"].to_numpy(float)
             freq = (ph[-1] - ph[0]) / (2 * np.pi * max(t[-1] - t[0], 1e-9))
@@ -233,12 +243,8 @@ def make_windows(
         step = max(1, int(round(period_frames / s.samples_per_cycle)))
         if s.max_step_s > 0:
             step = max(1, min(step, int(s.max_step_s / dt_cap + 1e-9)))
-        sg_s = (
-            s.sg_window_cycles * (1.0 / freq) ** s.sg_window_exponent
-            if s.sg_window_cycles > 0
-            else s.sg_window_s
-        )
-        sg = _odd_window(sg_s, dt_cap, s.sg_polyorder)
+        # the window the preprocessing used: from the frequency it knew, if any
+        sg = diff.window(1.0 / dt_cap, freq if known else None, len(t))
         half = sg // 2
         n_warm = int(round(s.warmup_cycles * period_frames / step)) * step
         n_score = int(round(s.cycles_per_window * period_frames))
@@ -252,8 +258,8 @@ def make_windows(
         ra = tr[["ra_1", "ra_2"]].to_numpy(float)
         ra_s = ra
         if s.ra_smooth_s > 0:
-            w = min(_odd_window(s.ra_smooth_s, dt_cap, s.sg_polyorder), len(t) - 1 + len(t) % 2)
-            ra_s = savgol_filter(ra, w, s.sg_polyorder, axis=0)
+            w = min(_odd_window(s.ra_smooth_s, dt_cap, diff.polyorder), len(t) - 1 + len(t) % 2)
+            ra_s = savgol_filter(ra, w, diff.polyorder, axis=0)
         meas = tr[list(CHANNELS)].to_numpy(float)
         speed = np.hypot(meas[:, 0], meas[:, 1])
         if pca is not None:
@@ -314,11 +320,11 @@ def make_windows(
                 n_fine=n_total,
                 score_from=n_warm,
                 n_scored=n_score,
-                sg_frames=sg,
+                diff_frames=sg,
                 ra_fine=np.stack(ra_fine),
             )
         )
-    return WindowSet(pd.DataFrame(rows), groups, s, pca)
+    return WindowSet(pd.DataFrame(rows), groups, s, pca, diff)
 
 
 def _window_config(cfg: SimConfig, d0_m: float, tol: float) -> SimConfig:
@@ -363,11 +369,8 @@ def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
         fine_t = np.arange(g.n_fine)
         fine = CubicSpline(coarse_t, pose, axis=1)(fine_t)
         dt_cap = g.dt / g.step
-        rates = np.moveaxis(
-            derivative(np.moveaxis(fine, 1, 0), dt_cap, g.sg_frames, s.sg_polyorder, s.sg_kernel),
-            0,
-            1,
-        )
+        along_time = np.moveaxis(fine, 1, 0)
+        rates = np.moveaxis(windows.differentiator(along_time, dt_cap, g.diff_frames), 0, 1)
         sc = slice(g.score_from, g.score_from + g.n_scored)
         heading = fine[:, sc, 2]
         c, sn = np.cos(heading), np.sin(heading)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
-import json
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -38,6 +37,9 @@ from suds_exp.discrepancy.select import (
     score_candidates,
     trial_losses,
 )
+from suds_exp.preprocess.rates import Differentiator
+from suds_exp.preprocess.version import get_version
+from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 from suds_exp.sim.config import SimConfig
 
 
@@ -104,7 +106,8 @@ class Step:
 
 @dataclass
 class DiscrepancyResult:
-    """Outcome of a run. ``named`` lists the accepted effects in order."""
+    """Outcome of a run. ``named`` lists the accepted effects in order; ``differentiator``
+    is the one the replay's rates went through (the preprocessing version's own)."""
 
     run_id: int | None
     name: str
@@ -118,6 +121,7 @@ class DiscrepancyResult:
     seconds: float
     cpu_seconds: float = 0.0
     report_dir: Path | None = None
+    differentiator: Differentiator | None = None
 
     @property
     def named(self) -> list[dict]:
@@ -161,6 +165,9 @@ class DiscrepancyResult:
             "run_id": self.run_id,
             "name": self.name,
             "prep_version": self.prep_version,
+            "differentiator": dataclasses.asdict(self.differentiator)
+            if self.differentiator is not None
+            else None,
             "named": self.named,
             "gap_before": self.gap_before,
             "gap_after": self.gap_after,
@@ -200,16 +207,6 @@ class DiscrepancyResult:
         }
 
 
-def parse_trial_ids(text: str | None) -> list[int] | None:
-    """``"3,5,8"`` -> [3, 5, 8]; None -> None (all trials)."""
-    if text is None or not text.strip():
-        return None
-    try:
-        return [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise DiscrepancyError(f"--trials {text!r}: expected a comma list of trial ids") from None
-
-
 def split_trials(info: pd.DataFrame, rng: np.random.Generator) -> tuple[list[int], list[int]]:
     """Split trials in two halves, stratified by (gait, frequency); by trial, never sample.
 
@@ -238,46 +235,9 @@ def _observable(cand: Candidate, model: SimConfig, probe: WindowSet) -> bool:
     return any(np.nanmax(np.abs(np.nan_to_num(x) - ref)) > 1e-9 for x in v[1:])
 
 
-def _resolve_prep(store, prep: str | int | None) -> tuple[str, dict]:
-    from suds_exp.preprocess import list_versions
-
-    versions = list_versions(store)
-    if versions.empty:
-        raise DiscrepancyError("--prep: no preprocessing version; run `suds-exp preprocess` first")
-    if prep is None:
-        if len(versions) != 1:
-            raise DiscrepancyError(
-                "--prep: name the preprocessing version to replay (have: "
-                + ", ".join(versions["name"].astype(str))
-                + ")"
-            )
-        row = versions.iloc[0]
-    else:
-        hit = versions[
-            (versions["name"].astype(str) == str(prep)) | (versions["id"].astype(str) == str(prep))
-        ]
-        if hit.empty:
-            raise DiscrepancyError(
-                f"--prep {prep}: no such preprocessing version (have: "
-                + ", ".join(versions["name"].astype(str))
-                + ")"
-            )
-        row = hit.iloc[0]
-    params = row["params"]
-    params = json.loads(params) if isinstance(params, str) else dict(params)
-    return str(row["name"]), params, int(row["id"])
-
-
 def load_pca(store, version_id: int):
     """The `PassivePCA` of a preprocessing version (None if it has none)."""
-    from suds_exp.preprocess.shape import PassivePCA
-
-    state = store.query_df(
-        "SELECT state FROM prep_fits WHERE version_id = ? AND kind = 'pca'", [version_id]
-    )
-    if state.empty:
-        return None
-    return PassivePCA.from_dict(json.loads(state["state"].iloc[0]))
+    return get_version(store, version_id).pca
 
 
 def _full_rate(rs: ReplaySettings) -> ReplaySettings:
@@ -335,7 +295,8 @@ def run_discrepancy(
         Report folder (index.html, PNG figures, Markdown/CSV tables); None: no report,
         unless ``default_out`` is given (then ``default_out / name``).
     samples : DataFrame, optional
-        A samples frame to use instead of loading one from the store.
+        A samples frame to use instead of loading one from the store; its rates are
+        taken to come from the default preprocessing parameters' differentiator.
     log : callable, optional
         Receives one line per stage (progress).
 
@@ -352,16 +313,15 @@ def run_discrepancy(
     if opts.max_effects < 0:
         raise DiscrepancyError(f"--max-effects {opts.max_effects}: must be >= 0")
     say = log or (lambda _msg: None)
-    prep_name, prep_params, pca = None, {}, None
+    prep_name, prep_params, pca, differ = None, {}, None, None
     if samples is None:
         if store is None:
             raise DiscrepancyError("run_discrepancy: give a store or a samples frame")
-        from suds_exp.preprocess import load_samples
-
-        prep_name, prep_params, prep_id = _resolve_prep(store, prep)
-        samples = load_samples(store, prep_name, trials)
+        version = get_version(store, prep)
+        prep_name, prep_params = version.name, version.params
+        samples, differ = version.samples(trials), version.differentiator()
         if opts.passive:
-            pca = load_pca(store, prep_id)
+            pca = version.pca
     elif trials is not None:
         samples = samples[samples["trial_id"].isin(list(trials))]
     if samples.empty:
@@ -375,7 +335,7 @@ def run_discrepancy(
         )
     rng = np.random.default_rng(opts.seed)
 
-    windows = make_windows(samples, rs, pca)
+    windows = make_windows(samples, rs, pca, differ)
     if len(windows.info) == 0:
         raise DiscrepancyError(
             "every trial is shorter than one replay window "
@@ -391,7 +351,9 @@ def run_discrepancy(
     scales = _scales(coarse_meas)
     # the gap itself (and the parameter refinement) is measured without decimation: the
     # decimated replay's own error would otherwise look like a systematic gap
-    full = make_windows(samples[samples["trial_id"].isin(windows.trial_id)], _full_rate(rs), pca)
+    full = make_windows(
+        samples[samples["trial_id"].isin(windows.trial_id)], _full_rate(rs), pca, differ
+    )
     meas_all = measured(full)
     is_test = np.isin(full.trial_id, test_ids)
     phase_all, ra_all, t_all = (window_field(full, f) for f in ("phase", "ra", "t"))
@@ -514,6 +476,7 @@ def run_discrepancy(
         outcome=outcome,
         seconds=time.perf_counter() - started,
         cpu_seconds=time.process_time() - cpu_started,
+        differentiator=windows.differentiator,
     )
     if out is not None:
         from suds_exp.discrepancy.report import write_report

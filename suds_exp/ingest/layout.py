@@ -11,23 +11,8 @@ from pathlib import Path
 
 from suds_exp.errors import IngestError
 from suds_exp.ingest.tables_csv import read_text_table
+from suds_exp.robot import ROLES  # the robot's marker roles (also imported from here)
 
-#: The robot's marker roles (DESIGN.md): top-face, raised (spoke) and lowered markers of
-#: the head and tail segments, and one marker on each flipper (1, 2 head; 3, 4 tail;
-#: odd = left, +Y side).
-ROLES = (
-    "head_top_1",
-    "head_top_2",
-    "head_spoke",
-    "tail_top_1",
-    "tail_top_2",
-    "tail_spoke",
-    "tail_back",
-    "flipper_1",
-    "flipper_2",
-    "flipper_3",
-    "flipper_4",
-)
 DEFAULT_LAYOUT = {role: role for role in ROLES}
 
 

@@ -8,13 +8,12 @@ manifest's folder (or absolute); ``frequency_hz`` may be a decimal or a fraction
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 from pathlib import Path
 
 from suds_exp.errors import IngestError
 from suds_exp.ingest.tables_csv import read_text_table
+from suds_exp.robot import GAITS, parse_frequency
 
-GAITS = ("S+", "S-", "O", "D-", "D+")
 COLUMNS = ("file", "gait", "frequency_hz", "repeat", "notes")
 
 
@@ -26,14 +25,6 @@ class Condition:
     frequency_hz: float
     repeat: int
     notes: str | None = None
-
-
-def parse_frequency(text: str) -> float:
-    """``"0.5"`` or ``"1/3"`` -> Hz as a float; raises ValueError on anything else."""
-    value = float(Fraction(text.strip()))
-    if value <= 0:
-        raise ValueError("non-positive")
-    return value
 
 
 def read_manifest(path: Path) -> dict[Path, Condition]:

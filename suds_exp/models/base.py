@@ -17,10 +17,8 @@ import pandas as pd
 from sklearn.base import BaseEstimator
 
 from suds_exp.errors import ConfigError, SudsError
+from suds_exp.robot import DRA_COLUMNS, RA_COLUMNS, VB_COLUMNS  # noqa: F401  (also imported from here)
 
-VB_COLUMNS = ("vx", "vy", "wz")
-RA_COLUMNS = ("ra_1", "ra_2")
-DRA_COLUMNS = ("dra_1", "dra_2")
 _RP_PATTERN = re.compile(r"^rp_(\d+)$")
 GAP_FACTOR = 5.0
 

@@ -25,23 +25,10 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.errors import ConfigError
+from suds_exp.robot import gait_shape, gait_shape_rate
 
-GAIT_K = {"S+": -4.0, "S-": -9.0, "O": np.inf, "D-": 9.0, "D+": 4.0}
 C_PASSIVE = np.array([[0.6, 0.0], [0.0, -0.4]])
 G_PASSIVE = np.array([[0.5, 0.2], [-0.2, 0.4]])
-
-
-def gait_shape(theta: np.ndarray, gait: str) -> tuple[np.ndarray, np.ndarray]:
-    """Contract gait r_a(theta) and d r_a / d theta, each of shape (n, 2), rad."""
-    if gait not in GAIT_K:
-        raise ConfigError(f"synthetic: gait={gait!r}; expected one of {', '.join(GAIT_K)}")
-    k = GAIT_K[gait]
-    s = 0.0 if np.isinf(k) else 1.0 / k  # D: +cos3/k, -sin3/k ; S: the opposite signs
-    r = np.stack([np.cos(theta) + s * np.cos(3 * theta), np.sin(theta) - s * np.sin(3 * theta)], 1)
-    dr = np.stack(
-        [-np.sin(theta) - 3 * s * np.sin(3 * theta), np.cos(theta) - 3 * s * np.cos(3 * theta)], 1
-    )
-    return r, dr
 
 
 def connection(ra: np.ndarray, rp: np.ndarray | None = None) -> np.ndarray:
@@ -89,7 +76,7 @@ def _trial(n_cycles, gait, f, spc, tube, passive, velocity, tau, ell, substeps, 
     tf = np.arange(nf) / (fs * substeps)
     theta0 = rng.uniform(0, 2 * np.pi)
     theta = 2 * np.pi * f * tf + theta0
-    g, dg = gait_shape(theta, gait)
+    g, dg = gait_shape(gait, theta), gait_shape_rate(gait, theta)
     e, de = _wobble(tf, f, tube, rng)
     amp = 1.0 + e[:, :2]
     ra = g * amp + e[:, 2:]

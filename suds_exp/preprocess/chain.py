@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from suds_exp.ingest.layout import ROLES
 from suds_exp.preprocess.body_frame import (
     Joints,
     SegmentFrames,
@@ -40,6 +39,7 @@ from suds_exp.preprocess.body_frame import (
     to_frame,
 )
 from suds_exp.preprocess.rates import local_polynomial, window_frames
+from suds_exp.robot import ROLES
 
 _ROLE = {role: i for i, role in enumerate(ROLES)}
 #: Rigid markers of each outer segment and the tail's flipper markers (hinged).

@@ -7,7 +7,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from suds_exp.ingest.layout import ROLES
 from suds_exp.preprocess.body_frame import (
     Joints,
     Plane,
@@ -21,11 +20,12 @@ from suds_exp.preprocess.body_frame import (
 from suds_exp.preprocess.chain import chain_pose
 from suds_exp.preprocess.params import TAIL_FITS
 from suds_exp.preprocess.shape import PASSIVE_ROLES, actuated_shape, passive_state
+from suds_exp.robot import ROLES, SPOKE_ROLES
 
 _ROLE = {role: i for i, role in enumerate(ROLES)}
 TOP = ("head_top_1", "head_top_2", "tail_top_1", "tail_top_2")
 #: Markers fixed on a segment; they define the motion plane.
-RIGID = (*TOP, "head_spoke", "tail_spoke", "tail_back")
+RIGID = (*TOP, *SPOKE_ROLES, "tail_back")
 
 
 @dataclass(frozen=True)

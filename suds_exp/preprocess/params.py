@@ -13,6 +13,8 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 from suds_exp.errors import ConfigError
+from suds_exp.robot import MAX_K
+from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 
 #: Every parameter, its default and meaning (units in the name or the text).
 DEFAULTS: dict[str, Any] = {
@@ -64,7 +66,6 @@ BODY_FITS = ("chain", "segments")
 SG_KERNELS = ("triweight", "box")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
-MAX_K = 12
 
 
 def _coerce(key: str, value: Any) -> Any:
@@ -158,21 +159,3 @@ def params_hash(params: Mapping[str, Any]) -> str:
     return hashlib.sha256(params_json(params).encode()).hexdigest()
 
 
-def parse_trial_ids(text: str | None) -> list[int] | None:
-    """``"1,2,5-8"`` -> [1, 2, 5, 6, 7, 8]; None or empty -> None (all trials)."""
-    if not text or not text.strip():
-        return None
-    ids: set[int] = set()
-    for part in text.split(","):
-        part = part.strip()
-        lo, sep, hi = part.partition("-")
-        try:
-            first, last = int(lo), int(hi) if sep else int(lo)
-        except ValueError:
-            raise ConfigError(
-                f"--trials {text!r}: expected ids and ranges such as 1,2,5-8"
-            ) from None
-        if first < 1 or last < first:
-            raise ConfigError(f"--trials {text!r}: {part!r} is not a valid id or range")
-        ids.update(range(first, last + 1))
-    return sorted(ids)

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
-from suds_exp.ingest.layout import ROLES, trial_layout
+from suds_exp.ingest.layout import trial_layout
 from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
 from suds_exp.preprocess.chain import chain_settings
 from suds_exp.preprocess.clean import CleanResult, clean_tracks
@@ -28,23 +28,18 @@ from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.rates import (
-    body_velocity,
-    derivative,
-    differentiator_window,
-    smooth,
-    window_frames,
-)
+from suds_exp.preprocess.rates import Differentiator, smooth, window_frames
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
-    DRP_COLUMNS,
-    RP_COLUMNS,
     prep_fits,
     prep_pca,
     prep_trials,
     prep_versions,
 )
+from suds_exp.preprocess.version import load_samples  # noqa: F401  (its old import path)
+from suds_exp.preprocess.version import require_tables as _require_tables
 from suds_exp.progress import progress_bar
+from suds_exp.robot import DRP_COLUMNS, ROLES, RP_COLUMNS
 from suds_exp.store import Store
 from suds_exp.store.tables import trials
 
@@ -90,39 +85,6 @@ class _Trial:
     clean: CleanResult
     measured: Measured
     kin: Kinematics | None = None
-
-
-# -- versions -----------------------------------------------------------------------------
-def _find_version(conn: sa.Connection, version: int | str) -> sa.Row:
-    v = prep_versions.c
-    if isinstance(version, int | np.integer) or (isinstance(version, str) and version.isdigit()):
-        row = conn.execute(sa.select(prep_versions).where(v.id == int(version))).first()
-    else:
-        row = conn.execute(sa.select(prep_versions).where(v.name == version)).first()
-        if row is None and len(version) >= 6:
-            found = conn.execute(
-                sa.select(prep_versions).where(v.params_hash.startswith(version))
-            ).fetchall()
-            row = found[0] if len(found) == 1 else None
-    if row is None:
-        known = conn.execute(sa.select(v.id, v.name).order_by(v.id)).fetchall()
-        listing = ", ".join(f"{r.id} ({r.name})" for r in known) or "none yet"
-        raise PreprocessError(
-            f"preprocessing version {version!r} not found; known versions: {listing}"
-        )
-    return row
-
-
-def _require_tables(conn: sa.Connection) -> None:
-    """Refuse a database made before preprocessing existed (its migration not applied)."""
-    found = conn.exec_driver_sql(
-        "SELECT count(*) FROM information_schema.tables WHERE table_name = 'prep_versions'"
-    ).scalar_one()
-    if not found:
-        raise PreprocessError(
-            "this database has no preprocessing tables yet; run `suds-exp preprocess` "
-            "(or `suds-exp init` to upgrade it)"
-        )
 
 
 def _group_key(kind: str, trial_id: int, gait: str | None, frequency_hz: float | None) -> str:
@@ -254,12 +216,12 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
     k = params["k"]
     dt = 1.0 / tr.rate_hz
     ra, passive = _smoothed(tr, params)
-    w = differentiator_window(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
-    po, kernel = params["sg_polyorder"], params.get("sg_kernel", "box")
-    dra = derivative(tr.kin.ra, dt, w, po, kernel)
-    drp = pca.transform_rate(derivative(tr.kin.passive, dt, w, po, kernel))
+    diff = Differentiator.from_params(params)
+    w = diff.window(tr.rate_hz, tr.frequency_hz, len(tr.t))
+    dra = diff(tr.kin.ra, dt, w)
+    drp = pca.transform_rate(diff(tr.kin.passive, dt, w))
     rp = pca.transform(passive)
-    vb = body_velocity(tr.kin.xy, tr.kin.heading, dt, w, po, kernel)
+    vb = diff.body_velocity(tr.kin.xy, tr.kin.heading, dt, w)
     phase = phaser.transform(_phaser_input(tr, pca, params))
     n = len(tr.t)
     cols: dict[str, Any] = {
@@ -529,64 +491,6 @@ def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
 
 
 # -- reading samples ----------------------------------------------------------------------
-def sample_columns(k: int) -> list[str]:
-    """The standard samples columns for k passive components, in order."""
-    return [
-        "trial_id",
-        "frame",
-        "t",
-        "phase",
-        "cycle",
-        "ra_1",
-        "ra_2",
-        "dra_1",
-        "dra_2",
-        *RP_COLUMNS[:k],
-        *DRP_COLUMNS[:k],
-        "vx",
-        "vy",
-        "wz",
-    ]
-
-
-def load_samples(
-    store: Store, version: int | str, trials: Iterable[int] | None = None
-) -> pd.DataFrame:
-    """The samples of a preprocessing version, ordered by trial and frame.
-
-    Parameters
-    ----------
-    store : Store
-    version : int or str
-        Version id, name, or a unique prefix (>= 6 characters) of its parameter hash.
-    trials : iterable of int, optional
-        Only these trial ids.
-
-    Returns
-    -------
-    DataFrame with columns ``trial_id, frame, t (s), phase (rad, unwrapped), cycle,
-    ra_1, ra_2 (rad), dra_1, dra_2 (rad/s), rp_1..rp_k (mm), drp_1..drp_k (mm/s),
-    vx, vy (mm/s), wz (rad/s)`` (body frame) and the trial's ``gait``, ``frequency_hz``.
-    """
-    with store.read() as conn:
-        _require_tables(conn)
-        row = _find_version(conn, version)
-        cols = sample_columns(row.k)
-        select = ", ".join(f's."{c}"' for c in cols)
-        where = "s.version_id = ?"
-        args: list[Any] = [row.id]
-        if trials is not None:
-            ids = sorted({int(i) for i in trials})
-            where += f" AND s.trial_id IN ({', '.join('?' * len(ids))})" if ids else " AND false"
-            args += ids
-        return Store.frame(
-            conn,
-            f"SELECT {select}, t.gait, t.frequency_hz FROM samples s "
-            f"JOIN trials t ON t.id = s.trial_id WHERE {where} ORDER BY s.trial_id, s.frame",
-            args,
-        )
-
-
 def list_versions(store: Store) -> pd.DataFrame:
     """One row per version: id, name, params_hash, k, trials done, samples, created_at,
     kept explained variance (fraction)."""

@@ -18,6 +18,9 @@ heading, with the linear velocity rotated into the body frame at each frame.
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.ndimage import convolve1d
@@ -39,25 +42,66 @@ def window_frames(window_s: float, rate_hz: float, polyorder: int, n_frames: int
     return min(w, limit)
 
 
+@dataclass(frozen=True)
+class Differentiator:
+    """A preprocessing version's differentiator (its ``sg_*`` parameters), the one both
+    preprocessing and the discrepancy replay apply, so their rates compare like with like.
+
+    When ``window_cycles`` > 0 and the trial's frequency (Hz) is known, the window is
+    ``window_cycles * T**window_exponent`` seconds, T = 1 / frequency the gait period in s:
+    ``window_cycles`` cycles at a 1 s period, growing as the period to the power
+    ``window_exponent`` (1 = a fixed number of cycles, 0 = fixed seconds; in between, a
+    slower gait, whose features are slower, gets a longer window but fewer cycles, since
+    the marker noise the window averages is the same at every frequency). Otherwise
+    ``window_s`` seconds. ``polyorder`` and ``kernel`` as in `derivative`.
+    Build one with `from_params`; `suds_exp.preprocess.get_version` gives a version's.
+    """
+
+    window_s: float
+    window_cycles: float
+    window_exponent: float
+    polyorder: int
+    kernel: str
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any]) -> Differentiator:
+        """The differentiator of a version's parameters (`suds_exp.preprocess.DEFAULTS`
+        keys). A version stored before ``sg_window_exponent`` / ``sg_kernel`` existed
+        used a fixed number of cycles and the box kernel."""
+        return cls(
+            window_s=float(params["sg_window_s"]),
+            window_cycles=float(params["sg_window_cycles"]),
+            window_exponent=float(params.get("sg_window_exponent", 1.0)),
+            polyorder=int(params["sg_polyorder"]),
+            kernel=str(params.get("sg_kernel", "box")),
+        )
+
+    def window(self, rate_hz: float, frequency_hz: float | None, n_frames: int) -> int:
+        """Odd window length in frames for a trial captured at ``rate_hz`` (Hz) with gait
+        frequency ``frequency_hz`` (Hz, None = unknown), ``n_frames`` long."""
+        if self.window_cycles > 0 and frequency_hz:
+            window_s = self.window_cycles * (1.0 / frequency_hz) ** self.window_exponent
+        else:
+            window_s = self.window_s
+        return window_frames(window_s, rate_hz, self.polyorder, n_frames)
+
+    def __call__(self, x: np.ndarray, dt: float, window: int) -> np.ndarray:
+        """Time derivative of ``x`` (n_frames, ...) along axis 0 over ``window`` frames
+        (from `window`); units of x per second, ``dt`` the frame interval in s."""
+        return derivative(x, dt, window, self.polyorder, self.kernel)
+
+    def body_velocity(
+        self, xy: np.ndarray, heading: np.ndarray, dt: float, window: int
+    ) -> np.ndarray:
+        """`body_velocity` with this differentiator: (n_frames, 3) mm/s, mm/s, rad/s."""
+        return body_velocity(xy, heading, dt, window, self.polyorder, self.kernel)
+
+
 def differentiator_window(
     params: dict, rate_hz: float, frequency_hz: float | None, n_frames: int
 ) -> int:
-    """A version's differentiator window, frames.
-
-    When ``sg_window_cycles`` is set and the trial's frequency (Hz) is known, the window is
-    ``sg_window_cycles * T**sg_window_exponent`` seconds, T = 1 / frequency the gait period
-    in s: ``sg_window_cycles`` cycles at a 1 s period, growing as the period to the power
-    ``sg_window_exponent`` (1 = a fixed number of cycles, 0 = fixed seconds; in between, a
-    slower gait, whose features are slower, gets a longer window but fewer cycles, since
-    the marker noise the window averages is the same at every frequency). Otherwise
-    ``sg_window_s`` seconds."""
-    if params["sg_window_cycles"] > 0 and frequency_hz:
-        # versions made before the exponent existed used a fixed number of cycles
-        exponent = params.get("sg_window_exponent", 1.0)
-        window_s = params["sg_window_cycles"] * (1.0 / frequency_hz) ** exponent
-    else:
-        window_s = params["sg_window_s"]
-    return window_frames(window_s, rate_hz, params["sg_polyorder"], n_frames)
+    """A version's differentiator window, frames (`Differentiator.window`)."""
+    return Differentiator.from_params(params).window(rate_hz, frequency_hz, n_frames)
 
 
 @functools.lru_cache(maxsize=64)

@@ -18,16 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from suds_exp.preprocess.body_frame import BodyPose, SegmentFrames
+from suds_exp.robot import PASSIVE_ROLES
 
-#: Passive markers (roles) in the order of the 12-vector, with their segment.
-PASSIVE_ROLES = (
-    ("head_spoke", "head"),
-    ("tail_spoke", "tail"),
-    ("flipper_1", "head"),
-    ("flipper_2", "head"),
-    ("flipper_3", "tail"),
-    ("flipper_4", "tail"),
-)
 PASSIVE_NAMES = tuple(f"{role}_{axis}" for role, _ in PASSIVE_ROLES for axis in "xy")
 
 

@@ -18,7 +18,7 @@ import pandas as pd
 from scipy.integrate import cumulative_trapezoid
 from scipy.spatial.transform import Rotation
 
-from suds_exp.ingest.layout import ROLES
+from suds_exp.robot import FREQUENCIES_HZ, GAITS, ROLES, gait_shape
 
 MIDDLE_MM = 100.0
 #: Marker positions in their segment frame (origin at the segment's joint, X along the
@@ -42,17 +42,6 @@ FLIPPERS = {
 HALF_WIDTH_MM = 20.0
 FLIPPER_MARKER_MM = 30.0
 FLIPPER_HEIGHT_MM = 30.0
-
-_GAIT_K = {"S+": -4.0, "S-": -9.0, "O": np.inf, "D-": 9.0, "D+": 4.0}
-
-
-def gait_shape(gait: str, theta: np.ndarray) -> np.ndarray:
-    """Commanded (phi1, phi2) of a gait at phases ``theta``: (n,) rad -> (n, 2) rad."""
-    k = _GAIT_K[gait]
-    return np.column_stack(
-        [np.cos(theta) + np.cos(3 * theta) / k, np.sin(theta) - np.sin(3 * theta) / k]
-    )
-
 
 @dataclass
 class SyntheticTrial:
@@ -195,8 +184,8 @@ def write_marker_csv(trial: SyntheticTrial, path: Path) -> Path:
 
 def write_dataset(
     folder: Path,
-    gaits=("S+", "S-", "O", "D-", "D+"),
-    frequencies=(1 / 3, 1 / 2, 1.0),
+    gaits=GAITS,
+    frequencies=FREQUENCIES_HZ,
     repeats: int = 1,
     n_cycles: float = 10.0,
     seed: int = 0,

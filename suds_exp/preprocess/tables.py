@@ -2,7 +2,7 @@
 
 import sqlalchemy as sa
 
-from suds_exp.preprocess.params import MAX_K
+from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
 
 metadata = sa.MetaData()
 
@@ -58,8 +58,6 @@ prep_trials = sa.Table(
     sa.Column("done_at", sa.DateTime, nullable=False),
 )
 
-RP_COLUMNS = tuple(f"rp_{i}" for i in range(1, MAX_K + 1))
-DRP_COLUMNS = tuple(f"drp_{i}" for i in range(1, MAX_K + 1))
 
 samples = sa.Table(
     "samples",

@@ -9,15 +9,13 @@ command's zero).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from suds_exp.preprocess.errors import PreprocessError
-from suds_exp.preprocess.pipeline import _find_version, load_samples
-from suds_exp.preprocess.rates import body_velocity, differentiator_window
+from suds_exp.preprocess.version import get_version
 from suds_exp.store import Store
 
 
@@ -44,12 +42,11 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
     the truth's content above the differentiator's band. Trials without a truth file are
     left out.
     """
-    samples = load_samples(store, version)
+    prep = get_version(store, version)
+    samples, diff = prep.samples(), prep.differentiator()
     files = store.query_df("SELECT id, source_file, sample_rate_hz FROM trials")
     source = dict(zip(files.id, files.source_file, strict=True))
     rate = dict(zip(files.id, files.sample_rate_hz, strict=True))
-    with store.read() as conn:
-        params = json.loads(_find_version(conn, version).params)
     rows, pooled = [], []
     for tid, s in samples.groupby("trial_id", sort=True):
         path = truth_path(source[tid])
@@ -59,15 +56,8 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
         if len(truth) != len(s):
             raise PreprocessError(f"{path}: {len(truth)} rows, but trial {tid} has {len(s)} frames")
         heading = np.unwrap(truth.theta.to_numpy())
-        window = differentiator_window(params, rate[tid], s.frequency_hz.iloc[0], len(truth))
-        band = body_velocity(
-            truth[["x", "y"]].to_numpy(),
-            heading,
-            1.0 / rate[tid],
-            window,
-            params["sg_polyorder"],
-            params.get("sg_kernel", "box"),
-        )
+        window = diff.window(rate[tid], s.frequency_hz.iloc[0], len(truth))
+        band = diff.body_velocity(truth[["x", "y"]].to_numpy(), heading, 1.0 / rate[tid], window)
         e = pd.DataFrame(
             {
                 "vx": s.vx.to_numpy() - truth.vx.to_numpy(),

@@ -5,17 +5,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from fractions import Fraction
 from pathlib import Path
 
 import pandas as pd
 
 from suds_exp.errors import ConfigError
+from suds_exp.robot import FREQUENCIES_HZ, GAITS, parse_frequency
 from suds_exp.sim.config import SimConfig, load_config
 from suds_exp.sim.connection import local_connection, save_connection
 from suds_exp.sim.dataset import simulate_dataset
 from suds_exp.sim.effects import effect_library, set_effect
-from suds_exp.sim.gaits import FREQUENCIES_HZ, GAITS
 
 
 def parse_gaits(text: str | None) -> tuple[str, ...]:
@@ -34,11 +33,13 @@ def parse_freqs(text: str | None) -> tuple[float, ...]:
     if not text:
         return FREQUENCIES_HZ
     try:
-        freqs = tuple(float(Fraction(f.strip())) for f in text.split(",") if f.strip())
-    except (ValueError, ZeroDivisionError):
-        raise ConfigError(f"--freqs {text!r}: expected Hz values such as 1/3,0.5,1") from None
-    if not freqs or min(freqs) <= 0:
-        raise ConfigError(f"--freqs {text!r}: frequencies must be > 0 Hz")
+        freqs = tuple(parse_frequency(f) for f in text.split(",") if f.strip())
+    except ValueError:
+        raise ConfigError(
+            f"--freqs {text!r}: expected Hz values > 0 such as 1/3,0.5,1"
+        ) from None
+    if not freqs:
+        raise ConfigError(f"--freqs {text!r}: expected Hz values > 0 such as 1/3,0.5,1")
     return freqs
 
 

@@ -16,9 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from suds_exp.errors import ConfigError
+from suds_exp.robot import FREQUENCIES_HZ, GAITS, gait_shape
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.files import write_manifest, write_qtm_tsv, write_truth
-from suds_exp.sim.gaits import FREQUENCIES_HZ, GAITS, actuate, gait_shape
+from suds_exp.sim.gaits import actuate
 from suds_exp.sim.markers import MARKER_NAMES, measure, true_marker_positions
 from suds_exp.sim.mechanics import simulate_prescribed
 

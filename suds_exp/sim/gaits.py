@@ -1,42 +1,15 @@
-"""Gait commands and the actuator model (command -> realised joint angles).
-
-Gaits (DESIGN.md), with theta = 2 pi f t + phase0:
-O: phi1 = cos th, phi2 = sin th; D-/D+: phi1 = cos th + cos(3 th)/k,
-phi2 = sin th - sin(3 th)/k (k = 9 / 4); S-/S+: phi1 = cos th - cos(3 th)/k,
-phi2 = sin th + sin(3 th)/k (k = 9 / 4).
-"""
+"""The actuator model (command -> realised joint angles); the gaits live in `suds_exp.robot`
+(imported here, where the simulator's callers have always found them)."""
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.signal import lfilter
 
-from suds_exp.errors import ConfigError
+from suds_exp.robot import FREQUENCIES_HZ, GAITS, gait_shape
 from suds_exp.sim.config import Actuator
 
-GAITS = ("S+", "S-", "O", "D-", "D+")
-FREQUENCIES_HZ = (1 / 3, 1 / 2, 1.0)
-
-# (sign of the cos(3 th) term in phi1, k); phi2's sin(3 th) term has the opposite sign
-_GAIT_TERMS = {
-    "S+": (-1.0, 4.0),
-    "S-": (-1.0, 9.0),
-    "O": (0.0, 1.0),
-    "D-": (1.0, 9.0),
-    "D+": (1.0, 4.0),
-}
-
-
-def gait_shape(gait: str, theta: np.ndarray) -> np.ndarray:
-    """Commanded (phi1, phi2) of `gait` at phases theta (rad): array (..., 2), rad."""
-    try:
-        sign, k = _GAIT_TERMS[gait]
-    except KeyError:
-        raise ConfigError(f"gait {gait!r}: expected one of {', '.join(GAITS)}") from None
-    theta = np.asarray(theta, dtype=float)
-    phi1 = np.cos(theta) + sign * np.cos(3 * theta) / k
-    phi2 = np.sin(theta) - sign * np.sin(3 * theta) / k
-    return np.stack([phi1, phi2], axis=-1)
+__all__ = ["FREQUENCIES_HZ", "GAITS", "actuate", "gait_shape"]
 
 
 def actuate(phi_cmd: np.ndarray, dt: float, actuator: Actuator, rng: np.random.Generator):

@@ -14,14 +14,14 @@ import math
 import numpy as np
 from scipy.signal import cont2discrete, lfilter, ss2tf
 
-from suds_exp.ingest.layout import ROLES
+from suds_exp.robot import ROLES, SPOKE_ROLES
 from suds_exp.sim.config import SimConfig
 
 #: The simulated robot carries one marker per role, named after the role, so its files
 #: need no marker layout (the ingest default).
 MARKER_NAMES = ROLES
 
-SPOKE_MARKERS = ("head_spoke", "tail_spoke")
+SPOKE_MARKERS = SPOKE_ROLES
 
 
 def marker_layout(cfg: SimConfig) -> dict[str, tuple[str, float, float, float]]:

@@ -50,8 +50,42 @@ def is_lock_error(exc: BaseException) -> bool:
     return "Could not set lock" in text or "Conflicting lock" in text
 
 
+#: DuckDB's words for a file it cannot use -> what to tell the user (after the path).
+_OPEN_PROBLEMS = (
+    ("not a valid DuckDB database file", "not a DuckDB database file"),
+    (
+        "Could not read enough bytes",
+        "the database file is truncated or damaged (shorter than its own header says); "
+        "restore it from a copy",
+    ),
+    ("Permission denied", "permission denied: cannot create or write the database there"),
+    ("No such file or directory", "cannot create the database: no such folder"),
+    ("Read-only file system", "cannot create or write the database on a read-only file system"),
+)
+
+
+def open_problem(exc: BaseException, path: Path) -> StoreError | None:
+    """The one-line `StoreError` for a database file DuckDB cannot open or create
+    (``exc`` an I/O error from DuckDB, or an `OSError` creating its folder); None for
+    any other error, which is left to surface as it is."""
+    orig = getattr(exc, "orig", exc)
+    if isinstance(orig, OSError):
+        reason = orig.strerror or str(orig)
+        return StoreError(f"{path}: cannot create the database's folder: {reason.lower()}")
+    if not isinstance(orig, duckdb.IOException):
+        return None
+    text = str(orig)
+    for needle, message in _OPEN_PROBLEMS:
+        if needle in text:
+            return StoreError(f"{path}: {message}")
+    return StoreError(f"{path}: cannot open the database: {text.splitlines()[0]}")
+
+
 def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAIT_S) -> T:
-    """Call ``open_fn`` until it stops failing on a file lock, for at most ``wait_s`` s."""
+    """Call ``open_fn`` until it stops failing on a file lock, for at most ``wait_s`` s.
+
+    A file DuckDB cannot open for another reason (not a database, truncated, a folder
+    that cannot be written) raises a one-line `StoreError` naming it."""
     deadline = time.monotonic() + wait_s
     delay = 0.02
     while True:
@@ -59,7 +93,10 @@ def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAI
             return open_fn()
         except (duckdb.IOException, sa.exc.DBAPIError) as exc:
             if not is_lock_error(exc):
-                raise
+                problem = open_problem(exc, path)
+                if problem is None:
+                    raise
+                raise problem from None
             if time.monotonic() >= deadline:
                 holder = str(exc).split("Conflicting lock is held in", 1)[-1].split(".")[0]
                 raise StoreError(

@@ -13,7 +13,7 @@ import sqlalchemy as sa
 
 from suds_exp.errors import StoreError
 from suds_exp.store import migrate
-from suds_exp.store.engine import default_db_path, make_engine, retry_on_lock
+from suds_exp.store.engine import default_db_path, make_engine, open_problem, retry_on_lock
 
 _frame_names = itertools.count()
 
@@ -42,7 +42,10 @@ class Store:
     # -- connections ---------------------------------------------------------------
     def upgrade(self, target: int | None = None) -> list[str]:
         """Create the file if needed and apply pending migrations; return their names."""
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise open_problem(exc, self.path) from None
         engine = make_engine(self.path)
         try:
             applied = retry_on_lock(lambda: migrate.upgrade(engine, target), self.path)
