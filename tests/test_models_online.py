@@ -127,3 +127,25 @@ def test_rollout_of_the_online_suds_learner(data):
     assert np.isfinite(out.to_numpy()).all()
     scale = float(np.sqrt(np.mean(test["vx_true"] ** 2)))
     assert rmse(out["vx"], test["vx_true"]) < 0.5 * scale
+
+
+def test_gradual_suds_takes_in_a_passive_coordinate_that_carries_information_only():
+    useful = make_samples(25, "O", 1.0, velocity="finsler", passive="lag", noise_v=1.0, seed=3)
+    g = make_model("GradualGMR+SUDS", n_components=8)
+    for c in cycles_of(useful):
+        g.partial_fit(c)
+    assert g.passive_columns_[:1] == ["rp_1"], g.gain_history_
+    first = g.added_[0]
+    assert first["column"] == "rp_1" and 0 < first["batch"] <= 25
+    assert first["n_seen"] == sum(len(c) for c in cycles_of(useful)[: first["batch"]])
+    assert list(g.predict(useful.head(200)).columns) == ["vx", "vy", "wz"]
+    # the same robot with two passive columns of pure noise: nothing comes in
+    noise = make_samples(30, "O", 1.0, velocity="finsler", passive="none", noise_v=1.0, seed=3)
+    rng = np.random.default_rng(1)
+    for i in (1, 2):
+        noise[f"rp_{i}"] = rng.standard_normal(len(noise))
+        noise[f"drp_{i}"] = 0.0
+    g = make_model("GradualGMR+SUDS", n_components=8)
+    for c in cycles_of(noise):
+        g.partial_fit(c)
+    assert g.added_ == [] and len(g.gain_history_) >= 20

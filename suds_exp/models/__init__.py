@@ -9,7 +9,8 @@
 | `GMR+SUDS`   | `agbr.GMRSuds`                 | A-GBR of (v_b, dr_p/dt) on (r_a, r_p, dr_a/dt) |
 
 Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(samples)`:
-`OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`).
+`OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
+`GradualGMR+SUDS` (`gradual.GradualGMRSuds`: GMR that adds passive coordinates online).
 
 Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 `predict(samples) -> DataFrame[vx, vy, wz(, drp_1..drp_k)]` with the input's index.
@@ -20,6 +21,7 @@ from __future__ import annotations
 from suds_exp.errors import ConfigError
 from suds_exp.models.agbr import GMR, GMRSuds
 from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
 from suds_exp.models.tls import TLS, TLSSuds
@@ -36,6 +38,7 @@ MODEL_NAMES = tuple(MODELS)
 ONLINE_MODELS: dict[str, type[Learner]] = {
     "OnlineGMR": OnlineGMR,
     "OnlineGMR+SUDS": OnlineGMRSuds,
+    "GradualGMR+SUDS": GradualGMRSuds,
 }
 
 
@@ -67,6 +70,7 @@ __all__ = [
     "ONLINE_MODELS",
     "OnlineGMR",
     "OnlineGMRSuds",
+    "GradualGMRSuds",
     "ModelError",
     "make_model",
     "GMR",
