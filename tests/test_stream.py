@@ -203,3 +203,18 @@ def test_stream_command_on_simulated_captures(tmp_path):
     assert doc["models"]["GMR"]["alarmed"] == 1
     out = runner.invoke(cli.app, ["stream", "late", "--db", db, "--change-at", "500"])
     assert out.exit_code == 2 and "past the end of trial" in out.output
+
+
+@pytest.mark.slow
+def test_no_alarm_on_unchanged_streams_in_at_least_95_percent_of_20_seeds():
+    steady = simulate_stream_samples("O", 1.0, 40, [], seeds=list(range(100, 120)))
+    rows = [
+        run_trial(trial, model, FAST, StreamSettings())
+        for _, trial in steady.groupby("trial_id")
+        for model in ("GMR", "OnlineGMR")
+    ]
+    rows = pd.concat(rows, ignore_index=True)
+    rows["change_s"] = None
+    for model, m in summarise(rows)["models"].items():
+        assert m["trials"] == 20
+        assert m["false_alarm_rate"] <= 0.05, (model, m)

@@ -21,8 +21,8 @@ replace the batch EM by stepwise EM on per-component sufficient statistics
   the standardisation and the homogeneity speed floor, as `GMR.fit` does).
 - birth: a component whose share of the weight falls below `min_share` / K (after a change,
   the data it explained are no longer seen and forgetting drains it) is re-born at the
-  batch sample the mixture explains worst, with the covariance of the whole (discounted)
-  data and the weight of `1 / K` of the batch; `n_births_` counts them.
+  batch sample the mixture explains worst, with the covariance of the batch and the
+  weight of `1 / K` of the batch; `n_births_` counts them.
 
 `fit(samples)` is a fresh start: the buffer initialisation on all of `samples` (exactly the
 batch EM of `GMR` with its defaults), so `fit` then `partial_fit` is a batch model that
@@ -241,16 +241,16 @@ class _OnlineMixin:
         if not len(dead):
             return
         loglik = logsumexp(log_gaussians(X, means, cov) + np.log(priors), axis=1)
-        total = self.stat_n_.sum()
-        mean_all = self.stat_s1_.sum(0) / total
-        cov_all = self.stat_s2_.sum(0) / total - np.outer(mean_all, mean_all)
+        # the newborn is as wide as the batch it comes from, not as the whole history: after
+        # a change that pins a coordinate (a jammed flipper), a component as wide as the old
+        # data could never win samples from one that has already shrunk onto the new data
+        mean_b = w @ X / w.sum()
+        cov_b = (X - mean_b).T @ ((X - mean_b) * w[:, None]) / w.sum()
         for k, i in zip(dead, np.argsort(loglik)[: len(dead)], strict=False):
             nk = w.sum() / K
-            # a component centred on the sample, as wide as the data: the next batches
-            # pull it to where the new data are
             self.stat_n_[k] = nk
             self.stat_s1_[k] = nk * X[i]
-            self.stat_s2_[k] = nk * (cov_all + np.outer(X[i], X[i]))
+            self.stat_s2_[k] = nk * (cov_b + np.outer(X[i], X[i]))
             self.n_births_ += 1
 
 
