@@ -169,7 +169,11 @@ def sql(
 
 EffectOption = Annotated[
     list[str] | None,
-    typer.Option("--effect", help="NAME=VALUE (or NAME.PARAM=VALUE, on, off); repeatable."),
+    typer.Option(
+        "--effect",
+        help="NAME=VALUE (or NAME.PARAM=VALUE, on, off); repeatable. "
+        "simulate also takes a schedule NAME=VALUE@TIMEs, e.g. flippers=locked@40s.",
+    ),
 ]
 SimConfigOption = Annotated[
     Path | None, typer.Option("--config", help="Simulator config (.toml or .json).")
@@ -539,6 +543,73 @@ def demo(
             f"open {summary.report} and {summary.discrepancy_report} in a browser "
             "to see the results"
         )
+
+
+# -- stream (online learners on a changing robot) ------------------------------------------
+@command()
+def stream(
+    name: Annotated[str, typer.Argument(help="Stream name (created, or continued).")],
+    models: Annotated[
+        str, typer.Option(help="Learners, comma-separated; online ones keep learning.")
+    ] = "GMR,OnlineGMR",
+    trials_: Annotated[
+        str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 (default: all).")
+    ] = None,
+    prep: Annotated[
+        str | None, typer.Option(help="Preprocessing version (default: the only one).")
+    ] = None,
+    warmup: Annotated[int, typer.Option(help="Cycles that train before scoring starts.")] = 10,
+    change_at: Annotated[
+        float | None,
+        typer.Option(help="Change time (s) of every trial (default: the simulator's schedule)."),
+    ] = None,
+    plot: Annotated[
+        Path | None, typer.Option(help="Write the error-against-time figure here (PNG).")
+    ] = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """Prequential evaluation: per trial in time order, predict each cycle, score it, then
+    learn it; report recovery after the change and Page-Hinkley drift alarms.
+
+    Rows go to table stream_cycles; a killed stream continues where it stopped.
+    Example: suds-exp simulate --out bed --gaits O --freqs 1 --repeats 4 --cycles 60
+    --effect medium_compaction=on@20s --ingest && suds-exp preprocess && suds-exp stream
+    bed --models GMR,OnlineGMR --plot reports/bed.png
+    """
+    from suds_exp.preprocess import parse_trial_ids
+    from suds_exp.stream import StreamSettings, plot_error, run_stream, stream_rows, summarise
+
+    store = open_store(db)
+    run = run_stream(
+        store,
+        name,
+        models,
+        parse_trial_ids(trials_),
+        prep,
+        StreamSettings(warmup_cycles=warmup),
+        change_at,
+        progress=not (quiet or json_),
+    )
+    rows = stream_rows(store, name)
+    summary = summarise(rows)
+    summary["run"] = run.to_dict()
+    if plot is not None:
+        summary["plot"] = str(plot_error(rows, plot))
+    if json_:
+        console.print_json(summary)
+        return
+    import pandas as pd
+
+    table = pd.DataFrame(summary["models"]).map(
+        lambda v: "-" if pd.isna(v) else (f"{v:.3g}" if isinstance(v, float) else v)
+    )
+    console.print_frame(
+        table.reset_index(names="per learner"), title=f"stream {name}: {run.done_now} new runs"
+    )
+    if plot is not None:
+        console.out.print(f"wrote {summary['plot']}")
 
 
 if __name__ == "__main__":

@@ -8,6 +8,10 @@
 | `GMR`        | `agbr.GMR`                     | A-GBR of v_b on (r_a, dr_a/dt)           |
 | `GMR+SUDS`   | `agbr.GMRSuds`                 | A-GBR of (v_b, dr_p/dt) on (r_a, r_p, dr_a/dt) |
 
+Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(samples)`:
+`OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
+`GradualGMR+SUDS` (`gradual.GradualGMRSuds`: GMR that adds passive coordinates online).
+
 Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 `predict(samples) -> DataFrame[vx, vy, wz(, drp_1..drp_k)]` with the input's index.
 """
@@ -17,6 +21,8 @@ from __future__ import annotations
 from suds_exp.errors import ConfigError
 from suds_exp.models.agbr import GMR, GMRSuds
 from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.gradual import GradualGMRSuds
+from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
 from suds_exp.models.tls import TLS, TLSSuds
 
@@ -28,6 +34,12 @@ MODELS: dict[str, type[Learner]] = {
     "GMR+SUDS": GMRSuds,
 }
 MODEL_NAMES = tuple(MODELS)
+#: Learners with `partial_fit(samples)`; kept out of MODEL_NAMES (the paper's five).
+ONLINE_MODELS: dict[str, type[Learner]] = {
+    "OnlineGMR": OnlineGMR,
+    "OnlineGMR+SUDS": OnlineGMRSuds,
+    "GradualGMR+SUDS": GradualGMRSuds,
+}
 
 
 def make_model(name: str, **params) -> Learner:
@@ -36,10 +48,11 @@ def make_model(name: str, **params) -> Learner:
     Unknown names or parameters raise ConfigError; parameter values are checked by `fit`.
     """
     try:
-        cls = MODELS[name]
+        cls = MODELS[name] if name in MODELS else ONLINE_MODELS[name]
     except KeyError:
         raise ConfigError(
-            f"unknown model {name!r}; expected one of {', '.join(MODEL_NAMES)}"
+            f"unknown model {name!r}; expected one of "
+            f"{', '.join(MODEL_NAMES + tuple(ONLINE_MODELS))}"
         ) from None
     valid = cls().get_params()
     bad = [p for p in params if p not in valid]
@@ -54,6 +67,10 @@ def make_model(name: str, **params) -> Learner:
 __all__ = [
     "MODELS",
     "MODEL_NAMES",
+    "ONLINE_MODELS",
+    "OnlineGMR",
+    "OnlineGMRSuds",
+    "GradualGMRSuds",
     "ModelError",
     "make_model",
     "GMR",

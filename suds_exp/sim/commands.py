@@ -78,8 +78,14 @@ def simulate_command(
     store=None,
     progress: Callable[[int, int], None] | None = None,
 ) -> dict:
-    """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary."""
-    cfg = build_config(config_path, effects)
+    """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary.
+
+    `effects` may hold schedules ``NAME=VALUE@Ts`` (see `suds_exp.sim.schedule`).
+    """
+    from suds_exp.sim.schedule import split_effects
+
+    static, changes = split_effects(effects)
+    cfg = build_config(config_path, static)
     start = time.perf_counter()
     ds = simulate_dataset(
         out,
@@ -90,6 +96,7 @@ def simulate_command(
         cycles=parse_cycles(cycles),
         seed=seed,
         progress=progress,
+        changes=changes,
     )
     wall = time.perf_counter() - start
     summary = {

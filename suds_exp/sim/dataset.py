@@ -114,8 +114,13 @@ def drive(spec: TrialSpec, cfg: SimConfig) -> tuple[np.ndarray, np.ndarray, np.n
     return t, phase, phi
 
 
-def simulate_trials(specs: list[TrialSpec], cfg: SimConfig) -> list[dict[str, np.ndarray]]:
-    """Simulate trials in one batched physics call; one truth-column dict per trial."""
+def simulate_trials(
+    specs: list[TrialSpec], cfg: SimConfig, changes: Sequence = ()
+) -> list[dict[str, np.ndarray]]:
+    """Simulate trials in one batched physics call; one truth-column dict per trial.
+
+    `changes`: `schedule.Change` items, effects that take hold during the trials.
+    """
     drives = [drive(s, cfg) for s in specs]
     if not specs:
         return []
@@ -124,13 +129,16 @@ def simulate_trials(specs: list[TrialSpec], cfg: SimConfig) -> list[dict[str, np
     lengths = np.array([len(d[0]) for d in drives])
     for k, (_, _, p) in enumerate(drives):
         phi[k, : len(p)] = p
-    out = simulate_prescribed(
-        phi,
-        1 / cfg.measurement.sample_rate_hz,
-        cfg,
-        pose0=np.array([s.pose0 for s in specs]),
-        n_frames=lengths,
-    )
+    dt = 1 / cfg.measurement.sample_rate_hz
+    start = dict(pose0=np.array([s.pose0 for s in specs]), n_frames=lengths)
+    if changes:
+        from suds_exp.sim.schedule import check_times, simulate_scheduled
+
+        ends = {s.name: (len(d[0]) - 1) * dt for s, d in zip(specs, drives, strict=True)}
+        check_times(changes, ends)
+        out = simulate_scheduled(phi, dt, cfg, changes, **start)
+    else:
+        out = simulate_prescribed(phi, dt, cfg, **start)
     truths = []
     for k, (t, phase, p) in enumerate(drives):
         n = len(t)
@@ -164,12 +172,15 @@ def simulate_dataset(
     seed: int = 0,
     progress: Callable[[int, int], None] | None = None,
     batch_size: int = 20,
+    changes: Sequence = (),
 ) -> SimulatedDataset:
     """Simulate a gait x frequency x repeat design and write its files into out_dir.
 
     Writes `<trial>.tsv` (QTM export of the 11 markers), `<trial>.truth.parquet` and
     `manifest.csv`. Default: the paper's design, 5 gaits x 3 frequencies x 4 repeats,
     10-30 cycles each. `progress(done, total)` is called after each written trial.
+    `changes` (`schedule.Change` items) switch effects on during every trial; they are
+    noted in the manifest as ``schedule=NAME=VALUE@Ts``.
     """
     cfg = SimConfig() if config is None else config
     out = Path(out_dir)
@@ -178,12 +189,17 @@ def simulate_dataset(
     except OSError as exc:
         raise ConfigError(f"{out}: cannot create output folder ({exc.strerror})") from None
     specs = plan_trials(gaits, frequencies_hz, repeats, cycles, seed)
+    if changes:
+        from suds_exp.sim.schedule import check_times
+
+        # refuse a schedule past any trial's end before writing anything
+        check_times(changes, {sp.name: sp.n_cycles / sp.frequency_hz for sp in specs})
     rows, tsvs, truths_written = [], [], []
     seconds = 0.0
     rate = cfg.measurement.sample_rate_hz
     for start in range(0, len(specs), batch_size):
         batch = specs[start : start + batch_size]
-        for spec, truth in zip(batch, simulate_trials(batch, cfg), strict=True):
+        for spec, truth in zip(batch, simulate_trials(batch, cfg, changes), strict=True):
             rng = np.random.default_rng(np.random.SeedSequence(spec.seed + (2,)))
             measured = measure(cfg, truth_markers(truth, cfg), rng)
             tsv = out / f"{spec.name}.tsv"
@@ -200,7 +216,8 @@ def simulate_dataset(
                     "gait": spec.gait,
                     "frequency_hz": f"{spec.frequency_hz:.6f}",
                     "repeat": spec.repeat,
-                    "notes": f"simulated seed={spec.seed[0]} cycles={spec.n_cycles}",
+                    "notes": f"simulated seed={spec.seed[0]} cycles={spec.n_cycles}"
+                    + "".join(f" schedule={c}" for c in changes),
                 }
             )
             tsvs.append(tsv)

@@ -1,0 +1,215 @@
+"""`run_stream`: prequential evaluation of learners on stored trials, resumable.
+
+A stream is named; its definition (learners and their parameters, trials, settings,
+change times) is stored in `streams` and a continuation must match it. The unit of work
+is one (learner, trial): its rows are computed by `prequential.run_trial` and written in
+one transaction, so a killed run loses at most the unit in hand, and a rerun skips the
+units already stored. Every unit is deterministic (learners are seeded), so a killed and
+resumed stream holds exactly the rows of an uninterrupted one (timings aside).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+
+import pandas as pd
+import sqlalchemy as sa
+
+from suds_exp.campaign.definition import differences, resolve_models
+from suds_exp.campaign.lock import RunLock
+from suds_exp.errors import SudsError
+from suds_exp.progress import progress_bar
+from suds_exp.store import Store
+from suds_exp.stream.prequential import StreamSettings, run_trial, trial_cycles
+
+_SCHEDULE = re.compile(r"schedule=\S+@([0-9.eE+-]+)s")
+
+
+class StreamError(SudsError):
+    """A stream cannot run as asked (bad option, definition differs from the stored one)."""
+
+
+@dataclass
+class StreamSummary:
+    """What a call of `run_stream` did."""
+
+    stream: str
+    units: int
+    done_before: int
+    done_now: int = 0
+    rows_now: int = 0
+    created: bool = False
+    trials: list[int] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def change_times(store: Store, trials: list[int]) -> dict[int, float | None]:
+    """First scheduled change (s) of each trial, from its notes (``schedule=...@Ts``)."""
+    if not trials:
+        return {}
+    notes = store.query_df(
+        f"SELECT id, notes FROM trials WHERE id IN ({', '.join('?' * len(trials))})", trials
+    )
+    out: dict[int, float | None] = {int(t): None for t in trials}
+    for tid, text in zip(notes.id, notes.notes, strict=True):
+        times = [float(m) for m in _SCHEDULE.findall(text or "")]
+        out[int(tid)] = min(times) if times else None
+    return out
+
+
+def _definition(models, trials, prep, settings, changes) -> dict:
+    return {
+        "prep": prep,
+        "models": resolve_models(models, "measured"),
+        "trials": [int(t) for t in trials],
+        "settings": dataclasses.asdict(settings),
+        "change_s": {str(k): v for k, v in changes.items()},
+    }
+
+
+def run_stream(
+    store: Store,
+    name: str,
+    models: list[str] | str | dict,
+    trials: list[int] | None = None,
+    prep: str | None = None,
+    settings: StreamSettings | None = None,
+    change_at: float | None = None,
+    samples: pd.DataFrame | None = None,
+    progress: bool = True,
+    on_unit: Callable[[int], None] | None = None,
+) -> StreamSummary:
+    """Create or continue stream `name`; fill `stream_cycles` with one row per scored cycle.
+
+    models: learner names (see `suds_exp.models.make_model`), comma text, or name ->
+    params. trials: trial ids (default: every trial of the version). prep: preprocessing
+    version (default: the only one). change_at: the change time (s) of every trial,
+    overriding the ``schedule=`` notes the simulator writes. samples: use this frame
+    instead of loading `prep` (tests, benchmarks; `prep` then only labels it).
+    on_unit(n_done) is called after each written (learner, trial).
+    """
+    from suds_exp.campaign.runner import _resolve_prep
+    from suds_exp.preprocess import load_samples
+
+    settings = settings or StreamSettings()
+    if settings.warmup_cycles < 1:
+        raise StreamError(f"--warmup: {settings.warmup_cycles}; expected >= 1 cycle")
+    if samples is None:
+        prep = _resolve_prep(store, prep)
+        samples = load_samples(store, prep, trials)
+    else:
+        prep = prep or "(samples given)"
+        if trials is not None:
+            samples = samples[samples["trial_id"].isin(trials)]
+    present = sorted(int(t) for t in samples["trial_id"].unique())
+    if trials is not None:
+        missing = sorted(set(int(t) for t in trials) - set(present))
+        if missing:
+            raise StreamError(
+                f"--trials: no samples of trial(s) {', '.join(map(str, missing))} "
+                f"in preprocessing version {prep}"
+            )
+    trials = present
+    if not trials:
+        raise StreamError(f"no samples in preprocessing version {prep}")
+    if change_at is not None:
+        changes: dict[int, float | None] = {t: float(change_at) for t in trials}
+    elif store.path.exists():
+        changes = change_times(store, trials) if _has_trials(store) else {t: None for t in trials}
+    else:
+        changes = {t: None for t in trials}
+    ends = samples.groupby("trial_id")["t"].max()
+    for t, c in changes.items():
+        if c is not None and not 0 < c < float(ends[t]):
+            raise StreamError(
+                f"change at {c:g} s: past the end of trial {t} ({float(ends[t]):.1f} s long); "
+                "expected 0 < time < the trial's duration"
+            )
+    for tid, g in samples.groupby("trial_id"):
+        n = len(trial_cycles(g, settings.min_samples))
+        if n <= settings.warmup_cycles:
+            raise StreamError(
+                f"trial {tid}: {n} whole cycles, not more than --warmup "
+                f"{settings.warmup_cycles}; give longer trials or a shorter warm-up"
+            )
+    definition = _definition(models, trials, prep, settings, changes)
+    summary = StreamSummary(name, len(definition["models"]) * len(trials), 0, trials=trials)
+    with RunLock(store.path, name):
+        summary.created = _register(store, name, prep, definition)
+        done = _done_units(store, name)
+        summary.done_before = len(done)
+        by_trial = {int(t): g for t, g in samples.groupby("trial_id", sort=True)}
+        bar = progress_bar(
+            f"Stream {name}", summary.units, progress, done=summary.done_before, unit="runs"
+        )
+        with bar as advance:
+            for tid in trials:
+                for model, params in definition["models"].items():
+                    if (model, tid) in done:
+                        continue
+                    rows = run_trial(by_trial[tid], model, params, settings)
+                    rows.insert(0, "stream", name)
+                    rows["change_s"] = changes[tid]
+                    with store.write() as conn:
+                        Store.insert_df(conn, "stream_cycles", rows)
+                    summary.done_now += 1
+                    summary.rows_now += len(rows)
+                    advance()
+                    if on_unit is not None:
+                        on_unit(summary.done_before + summary.done_now)
+    return summary
+
+
+def _has_trials(store: Store) -> bool:
+    with store.read() as conn:
+        return sa.inspect(conn).has_table("trials")
+
+
+def _register(store: Store, name: str, prep: str, definition: dict) -> bool:
+    """Store a new stream's definition, or check a continuation against it."""
+    text = json.dumps(definition, sort_keys=True)
+    with store.write() as conn:
+        row = conn.execute(
+            sa.text("SELECT definition FROM streams WHERE name = :n"), {"n": name}
+        ).first()
+        if row is None:
+            conn.execute(
+                sa.text(
+                    "INSERT INTO streams (name, prep_version, definition, created_at) "
+                    "VALUES (:n, :p, :d, :c)"
+                ),
+                {"n": name, "p": prep, "d": text, "c": datetime.now(UTC).replace(tzinfo=None)},
+            )
+            return True
+    stored = json.loads(row.definition)
+    diff = differences(stored, json.loads(text))
+    if diff:
+        raise StreamError(
+            f"stream {name!r} exists with a different definition ({'; '.join(diff)}); "
+            "use the same options or a new name"
+        )
+    return False
+
+
+def _done_units(store: Store, name: str) -> set[tuple[str, int]]:
+    done = store.query_df(
+        "SELECT DISTINCT model, trial_id FROM stream_cycles WHERE stream = ?", [name]
+    )
+    return {(m, int(t)) for m, t in zip(done.model, done.trial_id, strict=True)}
+
+
+def stream_rows(store: Store, name: str) -> pd.DataFrame:
+    """The stored rows of stream `name`, ordered by model, trial and cycle."""
+    rows = store.query_df(
+        "SELECT * FROM stream_cycles WHERE stream = ? ORDER BY model, trial_id, cycle", [name]
+    )
+    if rows.empty and store.query_df("SELECT 1 FROM streams WHERE name = ?", [name]).empty:
+        raise StreamError(f"no stream named {name!r}; start one with `suds-exp stream {name}`")
+    return rows
