@@ -287,7 +287,11 @@ def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
     prep: Annotated[str | None, typer.Option(help="Preprocessing version of the samples.")] = None,
     models: Annotated[
-        str | None, typer.Option(help="Learners, comma-separated (default: all five).")
+        str | None,
+        typer.Option(
+            help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
+            "(+SUDS), sklearn:ClassName[+SUDS]; survey = the five and the baselines."
+        ),
     ] = None,
     boots: Annotated[
         int | None, typer.Option(help="Draws per (train, test) pair (default 10).")
@@ -305,6 +309,10 @@ def run(
     test_conditions: Annotated[str | None, typer.Option(help="As --train-conditions.")] = None,
     mode: Annotated[
         str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
+    ] = None,
+    model_param: Annotated[
+        list[str] | None,
+        typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
     ] = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
     backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
@@ -331,6 +339,7 @@ def run(
         train_conditions=train_conditions,
         test_conditions=test_conditions,
         mode=mode,
+        model_params=model_param,
     )
     summary = run_campaign(
         open_store(db),
@@ -347,6 +356,40 @@ def run(
         console.out.print(summary.message())
     if summary.interrupted:
         raise typer.Exit(130)
+
+
+@command()
+def survey(
+    name: Annotated[str, typer.Argument(help="Campaign with a --sweep (e.g. --models survey).")],
+    cycles: Annotated[int, typer.Option(help="Main grid size: GMR's error target.")] = 30,
+    versus: Annotated[
+        str, typer.Option(help="Learner whose data need is set against GMR's.")
+    ] = "MLP",
+    n_boot: Annotated[int, typer.Option(help="Bootstrap resamples of the ratio.")] = 1000,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Data each learner needs and its speed: cycles to reach x1.25 of its own largest-sweep
+    error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio.
+
+    Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
+    """
+    from suds_exp.analysis.survey import survey_json, survey_tables
+
+    tables = survey_tables(open_store(db), name, cycles, n_boot, versus)
+    if json_:
+        console.print_json(survey_json(tables))
+        return
+    console.print_frame(tables["cycles"], title="cycles to target (median RMS error of vx)")
+    console.print_frame(tables["timing"], title="median fit / predict seconds")
+    r = tables["ratio"]
+    console.out.print(
+        f"{r['model']} needs {r['ratio']:.2f}x the data of {r['reference']} to reach its "
+        f"{cycles}-cycle error ({r['target']:.2f} mm/s): {r['cycles_model']:.1f} against "
+        f"{r['cycles_reference']:.1f} cycles; {100 * r['level']:.0f} % interval "
+        f"{r['low']:.2f}-{r['high']:.2f} ({r['n_boot']} paired bootstrap resamples, "
+        f"{100 * r['unreached']:.0f} % never reached)"
+    )
 
 
 @command()
