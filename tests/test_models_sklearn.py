@@ -94,9 +94,10 @@ def test_homogeneous_change_of_variables_generalises_across_frequency(swimmer):
 
 def test_seeded_estimators_repeat_and_the_seed_matters(swimmer):
     train, test = swimmer
-    a = make_model("MLP", random_state=3, max_iter=30).fit(train).predict(test)
-    b = make_model("MLP", random_state=3, max_iter=30).fit(train).predict(test)
-    c = make_model("MLP", random_state=4, max_iter=30).fit(train).predict(test)
+    small = dict(hidden_layer_sizes=(8,), max_iter=5)
+    a = make_model("MLP", random_state=3, **small).fit(train).predict(test)
+    b = make_model("MLP", random_state=3, **small).fit(train).predict(test)
+    c = make_model("MLP", random_state=4, **small).fit(train).predict(test)
     pd.testing.assert_frame_equal(a, b)
     assert not np.allclose(a["vx"], c["vx"])
 
@@ -169,6 +170,7 @@ def samples_file(tmp_path_factory):
     return path
 
 
+@pytest.mark.slow
 def test_user_regressors_run_in_a_campaign_survive_kills_and_resume_identically(
     tmp_path, samples_file
 ):
@@ -213,8 +215,13 @@ def survey_db(tmp_path_factory, samples_file):
     opts = CampaignOptions.parse(
         models=f"GMR,MLP,{CUSTOM}",
         sweep="1,2,3",
-        model_params=["MLP.max_iter=40", "MLP.hidden_layer_sizes=[16, 16]", f"{CUSTOM}.alpha=2"],
-        boots=3,
+        model_params=[
+            "GMR.n_components=4",
+            "MLP.max_iter=10",
+            "MLP.hidden_layer_sizes=[8, 8]",
+            f"{CUSTOM}.alpha=2",
+        ],
+        boots=2,
         train_cycles=2,
         train_conditions="O@0.5,O@1",
         test_conditions="O@0.5,O@1",
@@ -225,8 +232,9 @@ def survey_db(tmp_path_factory, samples_file):
 
 def test_model_params_from_the_command_line_are_stored(survey_db):
     d = json.loads(Store(survey_db).query_df("SELECT definition FROM campaigns")["definition"][0])
-    assert d["options"]["models"]["MLP"]["hidden_layer_sizes"] == [16, 16]
-    assert d["options"]["models"]["MLP"]["max_iter"] == 40
+    assert d["options"]["models"]["MLP"]["hidden_layer_sizes"] == [8, 8]
+    assert d["options"]["models"]["MLP"]["max_iter"] == 10
+    assert d["options"]["models"]["MLP"]["early_stopping"] is True  # the baseline's default
     assert d["options"]["models"][CUSTOM]["alpha"] == 2
 
 
@@ -278,3 +286,53 @@ def test_bad_learner_specs_are_refused_before_work_with_the_database_unchanged(
     assert before.keys() == after.keys()
     for table in before:
         pd.testing.assert_frame_equal(before[table], after[table])
+
+
+def power_law_results(scale: dict, sizes=(1, 2, 4, 8, 16, 30, 48), boots=5, noise=0.0):
+    """Sweep rows whose median error is scale[model] / sqrt(n_cycles) exactly."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for model, a in scale.items():
+        for f in (0.5, 1.0):
+            for n in sizes:
+                for b in range(boots):
+                    jitter = (b - (boots - 1) / 2) * noise + noise * 0.1 * rng.standard_normal()
+                    rows.append(
+                        dict(
+                            model=model,
+                            train_gait="O",
+                            train_frequency_hz=f,
+                            test_gait="O",
+                            test_frequency_hz=f,
+                            boot=b,
+                            n_cycles=n,
+                            rmse_vx=a / np.sqrt(n) * (1 + (jitter if b != (boots - 1) // 2 else 0)),
+                        )
+                    )
+    return pd.DataFrame(rows)
+
+
+def test_cycles_to_target_follow_the_error_curves_exactly():
+    from suds_exp.analysis.survey import cycles_to_target, efficiency_ratio
+
+    res = power_law_results({"GMR": 10.0, "MLP": 12.0, "slow": 100.0})
+    t = cycles_to_target(res, main_cycles=30).set_index(["model", "frequency_hz"])
+    # own target: 1.25 x a / sqrt(48) is reached at 48 / 1.25^2 cycles
+    np.testing.assert_allclose(t["cycles_own"], 48 / 1.25**2)
+    # GMR's 30-cycle error: GMR at 30, MLP at 30 x 1.2^2, "slow" never within 48
+    np.testing.assert_allclose(t.loc[("GMR", 0.5), "cycles_ref"], 30)
+    np.testing.assert_allclose(t.loc[("MLP", 1.0), "cycles_ref"], 30 * 1.44)
+    assert np.isnan(t.loc[("slow", 0.5), "cycles_ref"])
+    r = efficiency_ratio(res, "MLP", n_boot=50)
+    np.testing.assert_allclose(r["ratio"], 1.44)
+    assert r["low"] == pytest.approx(1.44) and r["high"] == pytest.approx(1.44)
+    assert efficiency_ratio(res, "slow", n_boot=20)["ratio"] == np.inf
+
+
+def test_the_ratio_interval_widens_with_noisy_draws():
+    from suds_exp.analysis.survey import efficiency_ratio
+
+    r = efficiency_ratio(
+        power_law_results({"GMR": 10.0, "MLP": 12.0}, noise=0.2), "MLP", n_boot=200
+    )
+    assert r["low"] < r["ratio"] < r["high"]

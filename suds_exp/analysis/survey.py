@@ -165,7 +165,8 @@ def efficiency_ratio(
         m_b, r_b = crossing(curve["m"], tgt), crossing(curve["r"], tgt)
         ratios[b] = np.inf if not np.isfinite(m_b) else m_b / r_b
     alpha = (1 - level) / 2
-    low, high = np.quantile(ratios, [alpha, 1 - alpha])
+    # percentiles of the resamples themselves (no interpolation: some may be inf)
+    low, high = np.quantile(ratios, [alpha, 1 - alpha], method="inverted_cdf")
     return {
         "model": model,
         "reference": reference,

@@ -359,7 +359,7 @@ def decode(value, name: str):
         except TypeError as exc:
             raise ConfigError(f"model {name!r}: {cls.__name__}: {exc}") from None
     if isinstance(value, list):
-        # pipeline steps are (name, estimator) pairs and must stay tuples to be set
+        # scikit-learn takes lists where it documents tuples (pipeline steps too)
         return [decode(v, name) for v in value]
     if isinstance(value, dict):
         return {k: decode(v, name) for k, v in value.items()}
@@ -397,8 +397,6 @@ def build(cls: type, name: str, suds: bool, defaults: dict, params: dict) -> Skl
     except (ValueError, TypeError) as exc:
         raise ConfigError(f"model {name}: {exc}") from None
     _check_values(estimator, name)
-    if "random_state" in est_params and "random_state" not in adapter:
-        adapter["random_state"] = est_params["random_state"]
     model = SklearnLearner(estimator=estimator, suds=suds, **adapter)
     model._validate()
     return model
