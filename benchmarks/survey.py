@@ -3,13 +3,15 @@
 Usage (from the repository root)::
 
     OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python benchmarks/survey.py \
-        [--db survey.duckdb] [--gaits O] [--boots 4] [--sweep 1,2,4,8,16,30,48] [--jobs 2]
+        [--db survey.duckdb] [--gaits O] [--boots 4] [--sweep 1,2,4,8,16,30,48] [--jobs 2] \
+        [--campaign survey] [--models survey] [--conditions O@0.5]
 
 Simulates the default dataset's design for ``--gaits`` (default: all five; 4 repeats of
 10-30 cycles at 1/3, 1/2 and 1 Hz, seed 0) into ``--db`` unless it already holds trials,
 preprocesses it with the default parameters (version ``v1``), runs (or continues: it is
-an ordinary campaign, resumable) campaign ``survey`` with ``--models survey`` (the
-paper's five and the scikit-learn baselines), and prints
+an ordinary campaign, resumable) campaign ``--campaign`` with ``--models`` (default
+``survey``: the paper's five and the scikit-learn baselines) on ``--conditions`` (train
+and test; default all), and prints
 
 1. cycles to reach x1.25 of each learner's error at the largest sweep size and to reach
    GMR's 30-cycle error, per learner and test frequency (median RMS error of vx over the
@@ -58,15 +60,24 @@ def main() -> None:
     p.add_argument("--sweep", default="1,2,4,8,16,30,48")
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--n-boot", type=int, default=1000)
+    p.add_argument("--campaign", default="survey")
+    p.add_argument("--models", default="survey")
+    p.add_argument("--conditions", default=None)
     args = p.parse_args()
     store = Store(args.db)
     ensure_data(store, args.gaits.split(","))
     options = CampaignOptions.parse(
-        prep="v1", models="survey", sweep=args.sweep, boots=args.boots, train_cycles=30
+        prep="v1",
+        models=args.models,
+        sweep=args.sweep,
+        boots=args.boots,
+        train_cycles=30,
+        train_conditions=args.conditions,
+        test_conditions=args.conditions,
     )
-    summary = run_campaign(store, "survey", options, jobs=args.jobs)
+    summary = run_campaign(store, args.campaign, options, jobs=args.jobs)
     print(summary.message())
-    t = survey_tables(store, "survey", 30, args.n_boot, "MLP")
+    t = survey_tables(store, args.campaign, 30, args.n_boot, "MLP")
     with __import__("pandas").option_context("display.width", 200, "display.max_rows", 200):
         print("\nCycles to target (median RMS error of vx, mm/s, same-condition draws):")
         print(t["cycles"].round(2).to_string(index=False))
