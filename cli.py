@@ -374,22 +374,15 @@ def survey(
 
     Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
     """
-    from suds_exp.analysis.survey import survey_json, survey_tables
+    from suds_exp.analysis.survey import ratio_sentence, survey_json, survey_tables
 
     tables = survey_tables(open_store(db), name, cycles, n_boot, versus)
     if json_:
         console.print_json(survey_json(tables))
         return
-    console.print_frame(tables["cycles"], title="cycles to target (median RMS error of vx)")
-    console.print_frame(tables["timing"], title="median fit / predict seconds")
-    r = tables["ratio"]
-    console.out.print(
-        f"{r['model']} needs {r['ratio']:.2f}x the data of {r['reference']} to reach its "
-        f"{cycles}-cycle error ({r['target']:.2f} mm/s): {r['cycles_model']:.1f} against "
-        f"{r['cycles_reference']:.1f} cycles; {100 * r['level']:.0f} % interval "
-        f"{r['low']:.2f}-{r['high']:.2f} ({r['n_boot']} paired bootstrap resamples, "
-        f"{100 * r['unreached']:.0f} % never reached)"
-    )
+    console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
+    console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
+    console.out.print(ratio_sentence(tables["ratio"], cycles))
 
 
 @command()

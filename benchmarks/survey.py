@@ -31,7 +31,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from suds_exp.analysis.survey import survey_tables  # noqa: E402
+from suds_exp.analysis.survey import ratio_sentence, survey_tables  # noqa: E402
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.campaign.definition import LEARNERS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
@@ -81,13 +81,7 @@ def main() -> None:
     with __import__("pandas").option_context("display.width", 200, "display.max_rows", 200):
         print("\nCycles to target (median RMS error of vx, mm/s, same-condition draws):")
         print(t["cycles"].round(2).to_string(index=False))
-        r = t["ratio"]
-        print(
-            f"\nMLP / GMR data to reach GMR's 30-cycle error ({r['target']:.2f} mm/s): "
-            f"{r['ratio']:.2f} ({r['cycles_model']:.1f} / {r['cycles_reference']:.1f} cycles), "
-            f"95 % interval {r['low']:.2f}-{r['high']:.2f} ({r['n_boot']} paired resamples, "
-            f"{100 * r['unreached']:.0f} % with MLP never reaching it)"
-        )
+        print("\n" + ratio_sentence(t["ratio"], 30))
         timing = t["timing"]
         at30 = timing[timing["n_cycles"] == 30].assign(
             total=lambda d: d["fit_seconds"] + d["predict_seconds"]

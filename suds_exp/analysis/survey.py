@@ -238,3 +238,24 @@ def survey_json(tables: dict) -> dict:
         else:
             out[key] = {k: clean(v) for k, v in value.items()}
     return out
+
+
+def ratio_sentence(r: dict, cycles: int) -> str:
+    """One line stating `efficiency_ratio`'s result."""
+    head = f"{r['model']} against {r['reference']}, target {r['reference']}'s {cycles}-cycle error"
+    head += f" ({r['target']:.2f} mm/s): "
+    if np.isfinite(r["ratio"]):
+        head += (
+            f"{r['model']} needs {r['ratio']:.2f}x the data ({r['cycles_model']:.1f} against "
+            f"{r['cycles_reference']:.1f} cycles)"
+        )
+    else:
+        head += (
+            f"{r['model']} does not reach it within the sweep ({r['reference']}: "
+            f"{r['cycles_reference']:.1f} cycles)"
+        )
+    return head + (
+        f"; {100 * r['level']:.0f} % interval {r['low']:.2f}-{r['high']:.2f} "
+        f"({r['n_boot']} paired bootstrap resamples, {100 * r['unreached']:.0f} % in which "
+        f"{r['model']} never reached it)"
+    )
