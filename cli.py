@@ -348,7 +348,11 @@ def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
     prep: Annotated[str | None, typer.Option(help="Preprocessing version of the samples.")] = None,
     models: Annotated[
-        str | None, typer.Option(help="Learners, comma-separated (default: all five).")
+        str | None,
+        typer.Option(
+            help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
+            "(+SUDS), sklearn:ClassName[+SUDS]; survey = the five and the baselines."
+        ),
     ] = None,
     boots: Annotated[
         int | None, typer.Option(help="Draws per (train, test) pair (default 10).")
@@ -366,6 +370,10 @@ def run(
     test_conditions: Annotated[str | None, typer.Option(help="As --train-conditions.")] = None,
     mode: Annotated[
         str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
+    ] = None,
+    model_param: Annotated[
+        list[str] | None,
+        typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
     ] = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
     backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
@@ -392,6 +400,7 @@ def run(
         train_conditions=train_conditions,
         test_conditions=test_conditions,
         mode=mode,
+        model_params=model_param,
     )
     summary = run_campaign(
         open_store(db),
@@ -408,6 +417,33 @@ def run(
         console.out.print(summary.message())
     if summary.interrupted:
         raise typer.Exit(130)
+
+
+@command()
+def survey(
+    name: Annotated[str, typer.Argument(help="Campaign with a --sweep (e.g. --models survey).")],
+    cycles: Annotated[int, typer.Option(help="Main grid size: GMR's error target.")] = 30,
+    versus: Annotated[
+        str, typer.Option(help="Learner whose data need is set against GMR's.")
+    ] = "MLP",
+    n_boot: Annotated[int, typer.Option(help="Bootstrap resamples of the ratio.")] = 1000,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Data each learner needs and its speed: cycles to reach x1.25 of its own largest-sweep
+    error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio.
+
+    Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
+    """
+    from suds_exp.analysis.survey import ratio_sentence, survey_json, survey_tables
+
+    tables = survey_tables(open_store(db), name, cycles, n_boot, versus)
+    if json_:
+        console.print_json(survey_json(tables))
+        return
+    console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
+    console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
+    console.out.print(ratio_sentence(tables["ratio"], cycles))
 
 
 @command()

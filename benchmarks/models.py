@@ -14,9 +14,10 @@ rate-independent swimmer of `suds_exp.models.synthetic` (passive="travel",
 velocity="finsler") instead.
 
 Sections:
-1. fit and predict seconds of every learner at 30 and 48 training cycles (~3000 and
-   ~4800 samples), predicting one 20-cycle test trial (2000 samples); medians over
-   `--repeats` runs, single-threaded BLAS recommended (the campaign runs one job a core).
+1. fit and predict seconds of every learner (the survey's baselines too) at 30 and 48
+   training cycles (~3000 and ~4800 samples), predicting one 20-cycle test trial (2000
+   samples); medians over `--repeats` runs, single-threaded BLAS recommended (the
+   campaign runs one job a core).
 2. Our EM + conditional mean against `gmr.GMM.from_samples` + `GMM.predict` at equal K
    on the same standardised data (GMR without augmentation or branching), with held-out
    RMSE of vx so the speed is compared at comparable accuracy.
@@ -132,6 +133,13 @@ def timings(trials, repeats):
         ("GMR", {}),
         ("GMR+SUDS", {}),
         ("GMR+SUDS", {"mode": "rollout"}),
+        # the survey's scikit-learn baselines (suds_exp/models/sklearn_adapter.py)
+        ("MLP", {"random_state": 0}),
+        ("MLP+SUDS", {"random_state": 0}),
+        ("MLP+SUDS", {"random_state": 0, "mode": "rollout"}),
+        ("GBT", {"random_state": 0}),
+        ("kNN", {}),
+        ("KRR", {"random_state": 0}),
     ]
     print("\n## 1. Fit and predict time (s), medians of", repeats, "runs; test trial", len(test))
     print("| learner | train samples | fit s | predict s | fit+predict s | RMSE vx mm/s |")
@@ -148,7 +156,7 @@ def timings(trials, repeats):
                 t2 = time.perf_counter()
                 fits.append(t1 - t0)
                 preds.append(t2 - t1)
-            label = name + (" (rollout)" if params else "")
+            label = name + (" (rollout)" if params.get("mode") == "rollout" else "")
             print(
                 f"| {label} | {len(tr)} ({n_cycles} cycles) | {median(fits):.4f} | "
                 f"{median(preds):.4f} | {median(fits) + median(preds):.4f} | "

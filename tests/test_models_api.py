@@ -30,8 +30,8 @@ def data():
 
 def test_make_model_knows_the_five_names():
     assert set(MODEL_NAMES) == {"phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS"}
-    with pytest.raises(ConfigError, match="unknown model 'MLP'"):
-        make_model("MLP")
+    with pytest.raises(ConfigError, match="unknown model 'CNN'"):
+        make_model("CNN")  # MLP is a survey baseline now (tests/test_models_sklearn.py)
     with pytest.raises(ConfigError, match="unknown parameter"):
         make_model("TLS", n_bin=3)
     assert issubclass(ModelError, SudsError)

@@ -26,6 +26,8 @@ from suds_exp.campaign.errors import CampaignError
 from suds_exp.robot import LEARNERS
 
 MODES = ("measured", "rollout")
+#: `--models survey`: the paper's five and the survey's scikit-learn baselines.
+SURVEY_LEARNERS = (*LEARNERS, "MLP", "MLP+SUDS", "GBT", "kNN", "KRR")
 DEFINITION_VERSION = 1
 
 
@@ -62,12 +64,60 @@ class CampaignOptions:
     mode: str | None = None
 
     @classmethod
-    def parse(cls, *, models: str | None = None, sweep: str | None = None, **rest):
-        """Options from command-line strings: ``models="TLS,GMR"``, ``sweep="1-10,21"``
-        (or ``"paper"``); the other fields as in the class."""
+    def parse(
+        cls,
+        *,
+        models: str | None = None,
+        sweep: str | None = None,
+        model_params: Sequence[str] | None = None,
+        **rest,
+    ):
+        """Options from command-line strings: ``models="TLS,GMR"`` (``survey`` stands for
+        `SURVEY_LEARNERS`), ``sweep="1-10,21"`` (or ``"paper"``), ``model_params`` as
+        ``["MLP.alpha=0.01", ...]`` (see `parse_model_params`); the rest as in the class."""
         names = None if models is None else [m.strip() for m in models.split(",") if m.strip()]
+        if names is not None:
+            names = [n for m in names for n in (SURVEY_LEARNERS if m == "survey" else (m,))]
         cycles = None if sweep is None else parse_int_list(sweep, "--sweep")
-        return cls(models=names, sweep=cycles, **rest)
+        chosen = names
+        if model_params:
+            chosen = parse_model_params(model_params, names or list(LEARNERS))
+        if chosen is not None:
+            # a bad learner spec fails here, before the database is opened
+            resolve_models(chosen, rest.get("mode") or DEFAULTS.mode)
+        return cls(models=chosen, sweep=cycles, **rest)
+
+
+def parse_model_params(items: Sequence[str], names: Sequence[str]) -> dict[str, dict]:
+    """``NAME.KEY=VALUE`` strings -> {name: {key: value}} over every name in ``names``.
+
+    NAME may itself hold dots (``sklearn:pkg.mod.Class``): KEY is what follows the last
+    dot before ``=``. VALUE is read as JSON (``true``, ``0.01``, ``[64, 64]``), else as a
+    Python literal (``(64, 64)``), else kept as text.
+    """
+    import ast
+
+    out: dict[str, dict] = {n: {} for n in names}
+    for item in items:
+        left, eq, text = item.partition("=")
+        name, dot, key = left.strip().rpartition(".")
+        if not eq or not dot or not name or not key:
+            raise CampaignError(
+                f"--model-param {item!r}: expected NAME.KEY=VALUE, e.g. MLP.alpha=0.01"
+            )
+        if name not in out:
+            raise CampaignError(
+                f"--model-param {item!r}: learner {name!r} is not in --models ({', '.join(names)})"
+            )
+        try:
+            value = json.loads(text)
+        except ValueError:
+            try:
+                value = ast.literal_eval(text)
+            except (ValueError, SyntaxError):
+                value = text
+        out[name][key.strip()] = value
+    return out
 
 
 DEFAULTS = CampaignOptions(
@@ -96,8 +146,8 @@ def merge_stored(options: CampaignOptions, stored: dict | None) -> CampaignOptio
 
 
 def resolve_models(models, mode: str) -> dict[str, dict]:
-    """Learner name -> the JSON-safe `get_params()` of ``make_model(name, **params)``."""
-    from suds_exp.models import make_model
+    """Learner name -> the JSON-safe recipe (`model_recipe`) of ``make_model(name, **params)``."""
+    from suds_exp.models import make_model, model_recipe
 
     if isinstance(models, str):
         models = [m.strip() for m in models.split(",") if m.strip()]
@@ -109,7 +159,7 @@ def resolve_models(models, mode: str) -> dict[str, dict]:
         model = make_model(name, **dict(params or {}))
         if "mode" in model.get_params(deep=False):
             model.set_params(mode=mode)
-        out[name] = json.loads(json.dumps(model.get_params(deep=False), default=_json_default))
+        out[name] = json.loads(json.dumps(model_recipe(model), default=_json_default))
     if not out:
         raise CampaignError("--models: no learner given; expected e.g. TLS,GMR")
     return out

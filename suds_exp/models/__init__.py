@@ -12,6 +12,10 @@ Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(s
 `OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
 `GradualGMR+SUDS` (`gradual.GradualGMRSuds`: GMR that adds passive coordinates online).
 
+Beyond the paper (`sklearn_adapter.py`): `MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each
+also `+SUDS`) and `sklearn:ClassName` / `sklearn:pkg.mod.Class` (any regressor, `+SUDS`
+for GMR+SUDS's inputs); `model_recipe(model)` is what a campaign stores to rebuild one.
+
 Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 `predict(samples) -> DataFrame[vx, vy, wz(, drp_1..drp_k)]` with the input's index.
 """
@@ -24,6 +28,7 @@ from suds_exp.models.base import Learner, ModelError
 from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
+from suds_exp.models.sklearn_adapter import SklearnLearner, baseline_names, make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
 
 MODELS: dict[str, type[Learner]] = {
@@ -40,19 +45,27 @@ ONLINE_MODELS: dict[str, type[Learner]] = {
     "OnlineGMR+SUDS": OnlineGMRSuds,
     "GradualGMR+SUDS": GradualGMRSuds,
 }
+#: The survey's named baselines (scikit-learn regressors with documented defaults).
+BASELINE_NAMES = baseline_names()
 
 
 def make_model(name: str, **params) -> Learner:
     """A new, unfitted learner by name (see MODEL_NAMES) with the given hyper-parameters.
 
-    Unknown names or parameters raise ConfigError; parameter values are checked by `fit`.
+    Also the baselines (BASELINE_NAMES) and `sklearn:ClassName[+SUDS]` (see
+    `sklearn_adapter`). Unknown names or parameters raise ConfigError; parameter values are
+    checked by `fit` (by scikit-learn's own checks here for the adapter).
     """
+    adapter = make_adapter(name, params) if name not in MODELS else None
+    if adapter is not None:
+        return adapter
     try:
         cls = MODELS[name] if name in MODELS else ONLINE_MODELS[name]
     except KeyError:
         raise ConfigError(
             f"unknown model {name!r}; expected one of "
-            f"{', '.join(MODEL_NAMES + tuple(ONLINE_MODELS))}"
+            f"{', '.join(MODEL_NAMES + tuple(ONLINE_MODELS) + BASELINE_NAMES)}"
+            " or sklearn:ClassName"
         ) from None
     valid = cls().get_params()
     bad = [p for p in params if p not in valid]
@@ -64,7 +77,18 @@ def make_model(name: str, **params) -> Learner:
     return cls(**params)
 
 
+def model_recipe(model: Learner) -> dict:
+    """JSON-safe keyword arguments that rebuild ``model`` with `make_model` (its name):
+    `get_params()` for the paper's learners, the deep recipe for scikit-learn ones."""
+    if isinstance(model, SklearnLearner):
+        return recipe(model)
+    return model.get_params(deep=False)
+
+
 __all__ = [
+    "BASELINE_NAMES",
+    "SklearnLearner",
+    "model_recipe",
     "MODELS",
     "MODEL_NAMES",
     "ONLINE_MODELS",

@@ -1,0 +1,99 @@
+"""The learner survey on simulated data: cycles to target, data ratio, time per learner.
+
+Usage (from the repository root)::
+
+    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python benchmarks/survey.py \
+        [--db survey.duckdb] [--gaits O] [--boots 4] [--sweep 1,2,4,8,16,30,48] [--jobs 2] \
+        [--campaign survey] [--models survey] [--conditions O@0.5]
+
+Simulates the default dataset's design for ``--gaits`` (default: all five; 4 repeats of
+10-30 cycles at 1/3, 1/2 and 1 Hz, seed 0) into ``--db`` unless it already holds trials,
+preprocesses it with the default parameters (version ``v1``), runs (or continues: it is
+an ordinary campaign, resumable) campaign ``--campaign`` with ``--models`` (default
+``survey``: the paper's five and the scikit-learn baselines) on ``--conditions`` (train
+and test; default all), and prints
+
+1. cycles to reach x1.25 of each learner's error at the largest sweep size and to reach
+   GMR's 30-cycle error, per learner and test frequency (median RMS error of vx over the
+   same-condition draws; `suds_exp.analysis.survey.cycles_to_target`);
+2. the MLP / GMR data ratio with its 95 % paired-bootstrap interval;
+3. median fit and predict seconds per learner at 30 cycles, and the survey's learners'
+   total against the paper's five (the issue's target: the survey grid no slower than
+   3x the five-learner grid).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from suds_exp.analysis.survey import ratio_sentence, survey_tables  # noqa: E402
+from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
+from suds_exp.campaign.definition import LEARNERS  # noqa: E402
+from suds_exp.store import Store  # noqa: E402
+
+
+def ensure_data(store: Store, gaits: list[str]) -> None:
+    """Simulate, ingest and preprocess when the database has no samples yet."""
+    from suds_exp.ingest import ingest_paths, list_trials
+    from suds_exp.preprocess import list_versions, preprocess
+    from suds_exp.sim.dataset import simulate_dataset
+
+    store.upgrade()
+    if list_trials(store).empty:
+        with tempfile.TemporaryDirectory() as folder:
+            sim = simulate_dataset(folder, gaits=gaits)
+            ingest_paths(store, [Path(folder)], sim.manifest, None, progress=False)
+    if "v1" not in list_versions(store)["name"].astype(str).tolist():
+        preprocess(store, name="v1", progress=False)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--db", default="survey.duckdb")
+    p.add_argument("--gaits", default="S+,S-,O,D-,D+")
+    p.add_argument("--boots", type=int, default=4)
+    p.add_argument("--sweep", default="1,2,4,8,16,30,48")
+    p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--n-boot", type=int, default=1000)
+    p.add_argument("--campaign", default="survey")
+    p.add_argument("--models", default="survey")
+    p.add_argument("--conditions", default=None)
+    args = p.parse_args()
+    store = Store(args.db)
+    ensure_data(store, args.gaits.split(","))
+    options = CampaignOptions.parse(
+        prep="v1",
+        models=args.models,
+        sweep=args.sweep,
+        boots=args.boots,
+        train_cycles=30,
+        train_conditions=args.conditions,
+        test_conditions=args.conditions,
+    )
+    summary = run_campaign(store, args.campaign, options, jobs=args.jobs)
+    print(summary.message())
+    t = survey_tables(store, args.campaign, 30, args.n_boot, "MLP")
+    with __import__("pandas").option_context("display.width", 200, "display.max_rows", 200):
+        print("\nCycles to target (median RMS error of vx, mm/s, same-condition draws):")
+        print(t["cycles"].round(2).to_string(index=False))
+        print("\n" + ratio_sentence(t["ratio"], 30))
+        timing = t["timing"]
+        at30 = timing[timing["n_cycles"] == 30].assign(
+            total=lambda d: d["fit_seconds"] + d["predict_seconds"]
+        )
+        print("\nMedian seconds per job at 30 cycles:")
+        print(at30.round(3).to_string(index=False))
+        five = at30[at30["model"].isin(LEARNERS)]["total"].sum()
+        print(
+            f"\nall {len(at30)} learners / the paper's five, per job: "
+            f"{at30['total'].sum() / five:.2f}x (target <= 3x)"
+        )
+
+
+if __name__ == "__main__":
+    main()

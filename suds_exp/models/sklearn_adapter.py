@@ -1,0 +1,522 @@
+"""Any scikit-learn regressor as a learner: `sklearn:ClassName`, a dotted path, baselines.
+
+`SklearnLearner(estimator)` gives a regressor the inputs of GMR, (r_a, dr_a/dt) -> v_b,
+or with `suds=True` those of GMR+SUDS, (r_a, r_p, dr_a/dt) -> (v_b, dr_p/dt), with
+rollout of r_p as GMR+SUDS does it (explicit Euler from each trial's first measured r_p,
+clipped to the training range widened by a tenth of its width).
+
+`homogeneous=True` is A-GBR's change of variables (see `agbr.py`): with
+rho = sqrt(|dr_a/dt|^2 + f0^2) (f0 = `speed_floor` x the training median |dr_a/dt|) the
+estimator learns (v_b, dr_p/dt) / rho from (r_a[, r_p], dr_a/dt / rho) and predictions
+are multiplied back by rho, so any regressor becomes exactly rate-independent.
+
+Names understood by `make_model`:
+
+- `sklearn:ClassName` - a regressor of scikit-learn found by class name
+  (`sklearn:MLPRegressor`), or `sklearn:package.module.Class` - any class with
+  fit/predict importable by that dotted path; `+SUDS` appended gives the SUDS inputs.
+- the named baselines of `BASELINES` (`MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR`, each also
+  with `+SUDS`), which are the same adapter with documented defaults.
+
+Keyword arguments of `make_model` go to the adapter when they are one of
+`ADAPTER_PARAMS`, else to the estimator (`estimator__KEY` forces the estimator). The
+estimator's own `random_state` is the adapter's: a campaign leaves it None and the runner
+seeds it from the job key. `recipe(model)` is the whole recipe as JSON-safe keyword
+arguments: `make_model(name, **recipe(model))` builds the same learner again, and the
+campaign stores it so that a resumed campaign compares exactly.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+import warnings
+
+import numpy as np
+import pandas as pd
+from sklearn.base import clone, is_classifier
+from sklearn.exceptions import ConvergenceWarning
+from sklearn.preprocessing import StandardScaler
+
+from suds_exp.errors import ConfigError
+from suds_exp.models.base import (
+    VB_COLUMNS,
+    Learner,
+    ModelError,
+    TimeSeries,
+    as_array,
+    check_choice,
+    check_float,
+    passive_columns,
+    require_columns,
+    rollout_bounds,
+)
+
+PREFIX = "sklearn:"
+SUDS_SUFFIX = "+SUDS"
+#: Keyword arguments of `make_model` that configure the adapter, not the estimator.
+ADAPTER_PARAMS = ("homogeneous", "speed_floor", "standardize", "mode", "random_state")
+_RA = re.compile(r"^ra_(\d+)$")
+#: Where `sklearn:ClassName` looks for ClassName, in this order.
+_SKLEARN_MODULES = (
+    "sklearn.neural_network",
+    "sklearn.ensemble",
+    "sklearn.neighbors",
+    "sklearn.kernel_ridge",
+    "sklearn.gaussian_process",
+    "sklearn.linear_model",
+    "sklearn.svm",
+    "sklearn.tree",
+    "sklearn.cross_decomposition",
+    "sklearn.multioutput",
+    "sklearn.pipeline",
+    "sklearn.compose",
+    "sklearn.dummy",
+    "sklearn.isotonic",
+)
+
+
+def actuated_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
+    """(["ra_1".."ra_m"], ["dra_1".."dra_m"]), m the consecutive ra_i columns present."""
+    present = {int(m.group(1)) for c in samples.columns if (m := _RA.match(str(c)))}
+    m = 0
+    while m + 1 in present:
+        m += 1
+    return [f"ra_{i}" for i in range(1, m + 1)], [f"dra_{i}" for i in range(1, m + 1)]
+
+
+def _multi_output(estimator) -> bool:
+    """Whether ``estimator`` fits a 2-D target itself (scikit-learn's tags; else assume so)."""
+    try:
+        from sklearn.utils import get_tags
+
+        return bool(get_tags(estimator).target_tags.multi_output)
+    except Exception:  # noqa: BLE001 - a foreign estimator without tags: try it as is
+        return True
+
+
+class SklearnLearner(Learner):
+    """A scikit-learn regressor on GMR's (or with ``suds`` GMR+SUDS's) inputs.
+
+    Parameters
+    ----------
+    estimator : scikit-learn regressor, unfitted
+        Cloned at every `fit`; it never sees the samples frame, only arrays.
+    suds : bool, default False
+        Inputs (r_a, r_p, dr_a/dt), outputs (v_b, dr_p/dt) as GMR+SUDS.
+    homogeneous : bool, default False
+        A-GBR's rate-homogeneous change of variables (module docstring).
+    speed_floor : float, default 0.1
+        f0 of `homogeneous`, as a fraction of the training median |dr_a/dt|.
+    standardize : bool, default True
+        Centre and scale every input and output column with the training mean and
+        standard deviation (regressors with a penalty or a distance need it).
+    mode : {"measured", "rollout"}, default "measured"
+        SUDS only: use the test trial's r_p, or integrate it from each trial's start.
+    random_state : int or None, default None
+        Given to the estimator's ``random_state`` (when it has one) at fit; None leaves
+        the estimator's own value.
+
+    Attributes
+    ----------
+    estimators_ : list of fitted clones (one, or one per output column when the estimator
+    takes a single target); `columns_in_`, `columns_out_`; `x_scaler_`, `y_scaler_`
+    (None without standardize); `speed_floor_` (rad/s); `rp_bounds_` (2, k) (SUDS).
+    """
+
+    def __init__(
+        self,
+        estimator=None,
+        suds: bool = False,
+        homogeneous: bool = False,
+        speed_floor: float = 0.1,
+        standardize: bool = True,
+        mode: str = "measured",
+        random_state=None,
+    ):
+        self.estimator = estimator
+        self.suds = suds
+        self.homogeneous = homogeneous
+        self.speed_floor = speed_floor
+        self.standardize = standardize
+        self.mode = mode
+        self.random_state = random_state
+
+    @property
+    def name(self) -> str:
+        cls = type(self.estimator).__name__ if self.estimator is not None else "None"
+        return PREFIX + cls + (SUDS_SUFFIX if self.suds else "")
+
+    def _validate(self):
+        check_regressor(self.estimator, self.name)
+        for key in ("suds", "homogeneous", "standardize"):
+            if not isinstance(getattr(self, key), bool | np.bool_):
+                raise ConfigError(
+                    f"{self.name}: {key}={getattr(self, key)!r}; expected true or false"
+                )
+        check_float("speed_floor", self.speed_floor, 0.0, self.name, strict=True)
+        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        rs = self.random_state
+        if rs is not None and (isinstance(rs, bool) or not isinstance(rs, int | np.integer)):
+            raise ConfigError(f"{self.name}: random_state={rs!r}; expected an integer or None")
+
+    def _columns(self, samples):
+        ra, dra = actuated_columns(samples)
+        if not ra:
+            raise ModelError(f"{self.name}: samples frame has no ra_1.. columns (actuated shape)")
+        rp, drp = passive_columns(samples) if self.suds else ([], [])
+        if self.suds and not rp:
+            raise ModelError(f"{self.name}: samples frame has no rp_1.. columns (passive shape)")
+        return ra + rp + dra, list(VB_COLUMNS) + drp, rp, drp, dra
+
+    def _rho(self, samples) -> np.ndarray:
+        """What rates are divided by, shape (n,): rho with `homogeneous`, else ones."""
+        if not self.homogeneous:
+            return np.ones(len(samples))
+        dra = as_array(samples, self.dra_columns_, self.name)
+        return np.sqrt((dra * dra).sum(axis=1) + self.speed_floor_**2)
+
+    def _inputs(self, samples):
+        X = as_array(samples, self.columns_in_, self.name)
+        f = self._rho(samples)
+        X[:, [c in self.dra_columns_ for c in self.columns_in_]] /= f[:, None]
+        return X, f
+
+    def fit(self, samples: pd.DataFrame, y=None):
+        self._validate()
+        cin, cout, rp, drp, dra = self._columns(samples)
+        require_columns(samples, ("trial_id", "t", *cin, *cout), self.name)
+        self.columns_in_, self.columns_out_ = cin, cout
+        self.rp_columns_, self.drp_columns_, self.dra_columns_ = rp, drp, dra
+        speed = np.linalg.norm(as_array(samples, dra, self.name), axis=1)
+        typical = float(np.median(speed)) or float(np.mean(speed)) or 1.0
+        self.speed_floor_ = self.speed_floor * typical
+        X, f = self._inputs(samples)
+        Y = as_array(samples, cout, self.name) / f[:, None]
+        self.x_scaler_ = self.y_scaler_ = None
+        if self.standardize:
+            self.x_scaler_ = StandardScaler().fit(X)
+            self.y_scaler_ = StandardScaler().fit(Y)
+            X, Y = self.x_scaler_.transform(X), self.y_scaler_.transform(Y)
+        est = clone(self.estimator)
+        if self.random_state is not None and "random_state" in est.get_params(deep=False):
+            est.set_params(random_state=int(self.random_state))
+        try:
+            with warnings.catch_warnings():
+                # max_iter is a budget the recipe states; reaching it is not news per job
+                warnings.simplefilter("ignore", ConvergenceWarning)
+                if _multi_output(est):
+                    self.estimators_ = [est.fit(X, Y)]
+                else:
+                    self.estimators_ = [clone(est).fit(X, Y[:, j]) for j in range(Y.shape[1])]
+        except (ValueError, TypeError) as exc:
+            lines = str(exc).strip().splitlines()
+            raise ModelError(f"{self.name}: fit failed: {lines[0] if lines else exc}") from None
+        self.n_features_in_ = X.shape[1]
+        if rp:
+            self.rp_bounds_ = rollout_bounds(as_array(samples, rp, self.name))
+        return self
+
+    def _raw_predict(self, X: np.ndarray) -> np.ndarray:
+        """Outputs (n, q) in the changed variables, before multiplying back by rho."""
+        if self.x_scaler_ is not None:
+            X = self.x_scaler_.transform(X)
+        if len(self.estimators_) == 1:
+            Y = np.asarray(self.estimators_[0].predict(X), dtype=float).reshape(len(X), -1)
+        else:
+            Y = np.column_stack([np.asarray(e.predict(X), dtype=float) for e in self.estimators_])
+        return self.y_scaler_.inverse_transform(Y) if self.y_scaler_ is not None else Y
+
+    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
+        self._check_fitted()
+        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
+        if self.suds and self.mode == "rollout":
+            return self._output_frame(self._predict_rollout(samples)[0], samples)
+        X, f = self._inputs(samples)
+        return self._output_frame(self._raw_predict(X) * f[:, None], samples)
+
+    def rollout(self, samples: pd.DataFrame) -> pd.DataFrame:
+        """r_p integrated from each trial's first sample, columns rp_1..rp_k, input's index."""
+        self._check_fitted()
+        if not self.suds:
+            raise ModelError(f"{self.name}: rollout needs a +SUDS learner")
+        require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
+        return pd.DataFrame(
+            self._predict_rollout(samples)[1], index=samples.index, columns=self.rp_columns_
+        )
+
+    def _predict_rollout(self, samples):
+        """(outputs (n, 3 + k), rolled-out r_p (n, k)) in the caller's order.
+
+        All trials advance together: step i predicts the i-th sample of every trial still
+        running in one call, so the estimator is called (longest trial) times, not n.
+        """
+        k = len(self.rp_columns_)
+        X, f = self._inputs(samples)
+        ts = TimeSeries.of(samples)
+        X, f = X[ts.order], f[ts.order]
+        rp_idx = np.array([self.columns_in_.index(c) for c in self.rp_columns_])
+        lo, hi = self.rp_bounds_
+        starts, ends = ts.starts[:-1], ts.starts[1:]
+        out = np.empty((len(X), len(self.columns_out_)))
+        rp = np.empty((len(X), k))
+        state = X[starts][:, rp_idx].copy()
+        for i in range(int((ends - starts).max())):
+            live = starts + i < ends
+            rows = (starts + i)[live]
+            if i > 0:
+                prev = rows - 1
+                step = ts.dt[rows] * f[prev]
+                state[live] = np.clip(state[live] + step[:, None] * out[prev, 3 : 3 + k], lo, hi)
+            x = X[rows].copy()
+            x[:, rp_idx] = state[live]
+            out[rows] = self._raw_predict(x)
+            rp[rows] = state[live]
+        return ts.unsort(out * f[:, None]), ts.unsort(rp)
+
+
+# -- names, checks and recipes ----------------------------------------------------------
+def check_regressor(estimator, name: str) -> None:
+    """ConfigError unless ``estimator`` is an unfitted-estimator object that regresses."""
+    if estimator is None or isinstance(estimator, type):
+        raise ConfigError(f"{name}: estimator={estimator!r}; expected an estimator instance")
+    missing = [
+        m for m in ("fit", "predict", "get_params") if not callable(getattr(estimator, m, None))
+    ]
+    if missing:
+        raise ConfigError(
+            f"{name}: {type(estimator).__name__} is not a regressor (no {', '.join(missing)})"
+        )
+    kind = getattr(estimator, "_estimator_type", None)
+    try:
+        from sklearn.utils import get_tags
+
+        kind = get_tags(estimator).estimator_type or kind
+    except Exception:  # noqa: BLE001 - foreign estimators may lack tags
+        pass
+    if is_classifier(estimator) or kind not in (None, "regressor"):
+        raise ConfigError(
+            f"{name}: {type(estimator).__name__} is a {kind or 'classifier'}, not a regressor"
+        )
+
+
+def resolve_class(path: str, name: str) -> type:
+    """The estimator class of ``sklearn:ClassName`` or a dotted path; ConfigError if none."""
+    if "." in path:
+        module, _, cls = path.rpartition(".")
+        try:
+            found = getattr(importlib.import_module(module), cls, None)
+        except ImportError as exc:
+            raise ConfigError(f"model {name!r}: cannot import {module!r} ({exc})") from None
+        if found is None:
+            raise ConfigError(f"model {name!r}: module {module!r} has no {cls!r}")
+    else:
+        found = None
+        for module in _SKLEARN_MODULES:
+            found = getattr(importlib.import_module(module), path, None)
+            if found is not None:
+                break
+        if found is None:
+            raise ConfigError(
+                f"model {name!r}: no scikit-learn regressor named {path!r}; give its "
+                "class name (sklearn:MLPRegressor) or a dotted path (sklearn:pkg.mod.Class)"
+            )
+    if not isinstance(found, type):
+        raise ConfigError(f"model {name!r}: {path!r} is not a class")
+    return found
+
+
+def encode(value):
+    """A parameter value as JSON-safe data; estimator-like objects (anything with
+    get_params, e.g. kernels, pipeline steps) become {"__class__": path, "params": {...}},
+    recursively, so the recipe is deep. Tuples become lists."""
+    if hasattr(value, "get_params") and not isinstance(value, type):
+        cls = type(value)
+        return {
+            "__class__": f"{cls.__module__}.{cls.__qualname__}",
+            "params": {k: encode(v) for k, v in value.get_params(deep=False).items()},
+        }
+    if isinstance(value, list | tuple):
+        return [encode(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): encode(v) for k, v in value.items()}
+    if isinstance(value, np.generic):
+        return value.item()
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    raise ConfigError(f"learner parameter {value!r} cannot be stored in a campaign definition")
+
+
+def decode(value, name: str):
+    """Inverse of `encode` (lists stay lists: scikit-learn takes them for tuples)."""
+    if isinstance(value, dict) and "__class__" in value:
+        cls = resolve_class(str(value["__class__"]), name)
+        params = {k: decode(v, name) for k, v in dict(value.get("params") or {}).items()}
+        try:
+            return cls(**params)
+        except TypeError as exc:
+            raise ConfigError(f"model {name!r}: {cls.__name__}: {exc}") from None
+    if isinstance(value, list):
+        # scikit-learn takes lists where it documents tuples (pipeline steps too)
+        return [decode(v, name) for v in value]
+    if isinstance(value, dict):
+        return {k: decode(v, name) for k, v in value.items()}
+    return value
+
+
+def build(cls: type, name: str, suds: bool, defaults: dict, params: dict) -> SklearnLearner:
+    """A SklearnLearner of ``cls`` with ``defaults`` then ``params`` (adapter keys split off)."""
+    merged = {**defaults, **params}
+    adapter = {k: merged.pop(k) for k in ADAPTER_PARAMS if k in merged}
+    if "suds" in merged:
+        raise ConfigError(f"model {name}: suds is set by the name; append +SUDS instead")
+    est_params = {}
+    for key, value in merged.items():
+        key = key.removeprefix("estimator__")
+        est_params[key] = decode(value, name)
+    try:
+        estimator = cls()
+    except TypeError as exc:
+        raise ConfigError(f"model {name!r}: {cls.__name__}() cannot be built ({exc})") from None
+    check_regressor(estimator, name)
+    valid = estimator.get_params(deep=True)
+    bad = [k for k in est_params if k not in valid]
+    if bad:
+        raise ConfigError(
+            f"model {name}: unknown parameter(s) {', '.join(bad)}; valid: "
+            + ", ".join(sorted([*ADAPTER_PARAMS, *estimator.get_params(deep=False)]))
+        )
+    # Top-level keys first: a nested key (kernel__length_scale) refers to the object set.
+    top = {k: v for k, v in est_params.items() if "__" not in k}
+    nested = {k: v for k, v in est_params.items() if "__" in k}
+    try:
+        estimator.set_params(**top)
+        estimator.set_params(**nested)
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(f"model {name}: {exc}") from None
+    _check_values(estimator, name)
+    model = SklearnLearner(estimator=estimator, suds=suds, **adapter)
+    model._validate()
+    return model
+
+
+def _check_values(estimator, name: str) -> None:
+    """scikit-learn's own check of parameter values, without data, where it has one."""
+    validate = getattr(estimator, "_validate_params", None)
+    if validate is None or not hasattr(estimator, "_parameter_constraints"):
+        return
+    try:
+        validate()
+    except (ValueError, TypeError) as exc:
+        raise ConfigError(f"model {name}: {str(exc).splitlines()[0]}") from None
+
+
+def recipe(model: SklearnLearner) -> dict:
+    """The keyword arguments that rebuild ``model`` with `make_model`, JSON-safe and deep:
+    the adapter's parameters and every parameter of the estimator (nested objects as
+    class path + parameters), the estimator's random_state excepted (it is the adapter's)."""
+    out = {k: encode(getattr(model, k)) for k in ADAPTER_PARAMS}
+    for key, value in model.estimator.get_params(deep=False).items():
+        if key == "random_state":
+            continue
+        out[("estimator__" + key) if key in ADAPTER_PARAMS else key] = encode(value)
+    return out
+
+
+# -- the named baselines ----------------------------------------------------------------
+def _mlp():
+    from sklearn.neural_network import MLPRegressor
+
+    return MLPRegressor
+
+
+def _gbt():
+    from sklearn.ensemble import HistGradientBoostingRegressor
+
+    return HistGradientBoostingRegressor
+
+
+def _knn():
+    from sklearn.neighbors import KNeighborsRegressor
+
+    return KNeighborsRegressor
+
+
+def _krr():
+    from suds_exp.models.baselines import NystroemKRR
+
+    return NystroemKRR
+
+
+#: name -> (class factory, default parameters); each also exists with +SUDS.
+BASELINES: dict[str, tuple] = {
+    # Two hidden layers of 64 tanh units: smooth maps of a few inputs; Adam, L2 1e-4,
+    # early stopping (10 epochs without gain on a 10 % validation split, at most 300).
+    "MLP": (
+        _mlp,
+        {
+            "hidden_layer_sizes": (64, 64),
+            "activation": "tanh",
+            "alpha": 1e-4,
+            "learning_rate_init": 1e-3,
+            "max_iter": 300,
+            "early_stopping": True,
+            "validation_fraction": 0.1,
+            "n_iter_no_change": 10,
+        },
+    ),
+    # Histogram gradient-boosted trees, one model per output, early stopping on 10 %.
+    "GBT": (
+        _gbt,
+        {"max_iter": 200, "learning_rate": 0.1, "max_leaf_nodes": 31, "early_stopping": True},
+    ),
+    # Distance-weighted mean of the 10 nearest training samples (standardised inputs).
+    "kNN": (_knn, {"n_neighbors": 10, "weights": "distance"}),
+    # Kernel ridge / GP posterior mean with an RBF kernel on 300 Nystroem landmarks.
+    "KRR": (_krr, {}),
+}
+
+
+def baseline_names() -> tuple[str, ...]:
+    return tuple(n for b in BASELINES for n in (b, b + SUDS_SUFFIX))
+
+
+def split_name(name: str) -> tuple[str, bool]:
+    """(name without +SUDS, whether it had it)."""
+    if name.endswith(SUDS_SUFFIX):
+        return name[: -len(SUDS_SUFFIX)], True
+    return name, False
+
+
+def make_adapter(name: str, params: dict) -> SklearnLearner | None:
+    """The learner of a `sklearn:...` or baseline name, or None for any other name."""
+    base, suds = split_name(name)
+    if base in BASELINES:
+        factory, defaults = BASELINES[base]
+        return build(factory(), name, suds, defaults, params)
+    if base.startswith(PREFIX):
+        path = base[len(PREFIX) :].strip()
+        if not path:
+            raise ConfigError(
+                f"model {name!r}: expected sklearn:ClassName or sklearn:pkg.mod.Class"
+            )
+        return build(resolve_class(path, name), name, suds, {}, params)
+    return None
+
+
+def is_adapter_name(name: str) -> bool:
+    base, _ = split_name(name)
+    return base in BASELINES or base.startswith(PREFIX)
+
+
+__all__ = [
+    "ADAPTER_PARAMS",
+    "BASELINES",
+    "SklearnLearner",
+    "actuated_columns",
+    "baseline_names",
+    "make_adapter",
+    "recipe",
+]
