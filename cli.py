@@ -242,6 +242,10 @@ def preprocess(
         str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 (default: all).")
     ] = None,
     list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
+    preset: Annotated[
+        str | None,
+        typer.Option(help="Named parameter set under --param: default | paper (the paper's own)."),
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -250,6 +254,7 @@ def preprocess(
 
     The same parameters are the same version: re-running skips the trials already done.
     Example: suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-20
+    Example: suds-exp preprocess --preset paper --name paper
     """
     from suds_exp.preprocess import list_versions, parse_param_items, parse_trial_ids
     from suds_exp.preprocess import preprocess as run_preprocess
@@ -269,6 +274,7 @@ def preprocess(
         parse_param_items(param or []),
         parse_trial_ids(trials_),
         progress=not (quiet or json_),
+        preset=preset,
     )
     if json_:
         console.print_json(result.to_dict())

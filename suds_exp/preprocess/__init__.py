@@ -4,8 +4,10 @@ stored as named, versioned parameter sets."""
 from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.params import (
     DEFAULTS,
+    PRESETS,
     parse_param_items,
     parse_trial_ids,
+    preset_params,
     resolve_params,
 )
 from suds_exp.preprocess.phaser import Phaser
@@ -19,6 +21,7 @@ from suds_exp.preprocess.pipeline import (
 
 __all__ = [
     "DEFAULTS",
+    "PRESETS",
     "Phaser",
     "PrepResult",
     "PreprocessError",
@@ -27,6 +30,7 @@ __all__ = [
     "parse_param_items",
     "parse_trial_ids",
     "preprocess",
+    "preset_params",
     "resolve_params",
     "sample_columns",
 ]

@@ -236,8 +236,16 @@ def _concat_frames(items: list[_Trial]) -> SegmentFrames:
     )
 
 
+#: Phaser channel order of the Cartesian r_a (head x, head y, tail x, tail y): the y values
+#: first, since Phaser's channel 0 sets the Poincare section and the reference rate, and a
+#: segment's x (cos of its angle) goes round twice per gait cycle.
+_CARTESIAN_PHASER_ORDER = [1, 3, 0, 2]
+
+
 def _phaser_input(tr: _Trial, pca: PassivePCA, params: dict) -> np.ndarray:
     ra, passive = _smoothed(tr, params)
+    if params.get("ra_repr", "angles") == "cartesian":
+        ra = ra[:, _CARTESIAN_PHASER_ORDER]
     if params["phaser_channels"] == "ra+rp":
         return np.column_stack([ra, pca.transform(passive)])
     return ra
@@ -269,11 +277,11 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
         "t": tr.t,
         "phase": phase,
         "cycle": cycles(phase).astype(np.int32),
-        "ra_1": ra[:, 0],
-        "ra_2": ra[:, 1],
-        "dra_1": dra[:, 0],
-        "dra_2": dra[:, 1],
     }
+    for i in range(ra.shape[1]):
+        cols[f"ra_{i + 1}"] = ra[:, i]
+    for i in range(ra.shape[1]):
+        cols[f"dra_{i + 1}"] = dra[:, i]
     for i in range(len(RP_COLUMNS)):
         cols[RP_COLUMNS[i]] = rp[:, i] if i < k else np.full(n, np.nan)
         cols[DRP_COLUMNS[i]] = drp[:, i] if i < k else np.full(n, np.nan)
@@ -337,6 +345,7 @@ def preprocess(
     params: Mapping[str, Any] | None = None,
     trials: Iterable[int] | None = None,
     progress: bool = True,
+    preset: str | None = None,
 ) -> PrepResult:
     """Create or reuse the preprocessing version of ``params`` and fill its samples.
 
@@ -352,6 +361,9 @@ def preprocess(
         Trial ids to process (default: every trial in the store).
     progress : bool
         Show progress bars on stderr.
+    preset : str, optional
+        A named parameter set (`suds_exp.preprocess.params.PRESETS`: ``default``,
+        ``paper``) under ``params``.
 
     Returns
     -------
@@ -361,7 +373,7 @@ def preprocess(
     gap longer than ``max_gap_s``; `ConfigError` for a bad parameter.
     """
     started = time.perf_counter()
-    params = resolve_params(params)
+    params = resolve_params(params, preset)
     digest = params_hash(params)
     wanted = None if trials is None else sorted({int(i) for i in trials})
     v = prep_versions.c
@@ -429,7 +441,7 @@ def preprocess(
         joints = {tr.id: fit_joints(tr.measured.frames) for tr in items}
     for tr in items:
         chain = chain_settings(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
-        tr.kin = kinematics(tr.measured, joints[tr.id], chain)
+        tr.kin = kinematics(tr.measured, joints[tr.id], chain, params["ra_repr"])
     if ("pca", "") in fits:
         pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
     else:
@@ -529,18 +541,17 @@ def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
 
 
 # -- reading samples ----------------------------------------------------------------------
-def sample_columns(k: int) -> list[str]:
-    """The standard samples columns for k passive components, in order."""
+def sample_columns(k: int, m: int = 2) -> list[str]:
+    """The standard samples columns for k passive components and m actuated values
+    (2 joint angles, or 4 Cartesian values with ``ra_repr="cartesian"``), in order."""
     return [
         "trial_id",
         "frame",
         "t",
         "phase",
         "cycle",
-        "ra_1",
-        "ra_2",
-        "dra_1",
-        "dra_2",
+        *(f"ra_{i}" for i in range(1, m + 1)),
+        *(f"dra_{i}" for i in range(1, m + 1)),
         *RP_COLUMNS[:k],
         *DRP_COLUMNS[:k],
         "vx",
@@ -565,13 +576,14 @@ def load_samples(
     Returns
     -------
     DataFrame with columns ``trial_id, frame, t (s), phase (rad, unwrapped), cycle,
-    ra_1, ra_2 (rad), dra_1, dra_2 (rad/s), rp_1..rp_k (mm), drp_1..drp_k (mm/s),
+    ra_1, ra_2 (rad), dra_1, dra_2 (rad/s)`` (or ``ra_1..ra_4`` (mm), ``dra_1..dra_4``
+    (mm/s) for a version with ``ra_repr="cartesian"``), ``rp_1..rp_k (mm), drp_1..drp_k (mm/s),
     vx, vy (mm/s), wz (rad/s)`` (body frame) and the trial's ``gait``, ``frequency_hz``.
     """
     with store.read() as conn:
         _require_tables(conn)
         row = _find_version(conn, version)
-        cols = sample_columns(row.k)
+        cols = sample_columns(row.k, actuated_dimension(json.loads(row.params)))
         select = ", ".join(f's."{c}"' for c in cols)
         where = "s.version_id = ?"
         args: list[Any] = [row.id]
@@ -585,6 +597,11 @@ def load_samples(
             f"JOIN trials t ON t.id = s.trial_id WHERE {where} ORDER BY s.trial_id, s.frame",
             args,
         )
+
+
+def actuated_dimension(params: Mapping[str, Any]) -> int:
+    """m, the number of r_a columns of a version with these parameters."""
+    return 4 if params.get("ra_repr", "angles") == "cartesian" else 2
 
 
 def list_versions(store: Store) -> pd.DataFrame:
