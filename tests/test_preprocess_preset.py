@@ -112,3 +112,14 @@ def test_unknown_preset_is_a_one_line_error_and_changes_nothing(ingested, tmp_pa
     assert "--preset papers: unknown preset; expected one of default, paper" in out.output
     assert len(out.output.strip().splitlines()) == 1
     assert_same_db(before, dump_db(db))
+
+
+def test_campaign_samples_keep_every_actuated_column(paper):
+    from suds_exp.campaign.bank import SampleBank
+
+    db, version = paper
+    bank = SampleBank.build(load_samples(Store(db), version))
+    assert [c for c in bank.columns if "ra_" in c] == [
+        *(f"ra_{i}" for i in (1, 2)), *(f"dra_{i}" for i in (1, 2)),
+        *(f"ra_{i}" for i in (3, 4)), *(f"dra_{i}" for i in (3, 4)),
+    ]  # fmt: skip
