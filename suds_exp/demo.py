@@ -118,7 +118,7 @@ def run_demo(
     summary.report = write_report(store, campaign, report_dir / campaign)
     say(f"report written to {summary.report} ({lap('report'):.0f} s)")
 
-    table = findings(store, campaign, n_boot=200)
+    table = findings(store, campaign)  # the same table as the report's first section
     summary.findings = findings_json(table, campaign)["statistics"]
     summary.findings_headline = findings_headline(table)
     say(
