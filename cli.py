@@ -312,6 +312,14 @@ def run(
     mode: Annotated[
         str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
     ] = None,
+    skip_infeasible: Annotated[
+        bool | None,
+        typer.Option(
+            "--skip-infeasible/--no-skip-infeasible",
+            help="Leave out the (condition, training size) cells the data cannot supply "
+            "instead of refusing the campaign; stored in its definition.",
+        ),
+    ] = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
     backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
     scheduler: Annotated[
@@ -337,6 +345,7 @@ def run(
         train_conditions=train_conditions,
         test_conditions=test_conditions,
         mode=mode,
+        skip_infeasible=skip_infeasible,
     )
     summary = run_campaign(
         open_store(db),
@@ -400,6 +409,29 @@ def report(
         console.print_json({"index": str(index), "files": files})
     else:
         console.out.print(f"wrote {index}")
+
+
+@command()
+def findings(
+    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    boot: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
+    seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """The paper's findings F1-F10 measured on a campaign: statistic, value, 95 % bootstrap
+    interval, holds / unclear / fails / not measurable (definitions in the README).
+
+    Example: suds-exp findings paper --json
+    """
+    from suds_exp.analysis.findings import findings as measure
+    from suds_exp.analysis.findings import findings_json, print_findings
+
+    table = measure(open_store(db), name, n_boot=boot, seed=seed)
+    if json_:
+        console.print_json(findings_json(table, name))
+    else:
+        print_findings(table, name)
 
 
 @command()
