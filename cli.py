@@ -289,6 +289,10 @@ def preprocess(
         str | None,
         typer.Option(help="Body description: a TOML file, or 'swimmer' (the default body)."),
     ] = None,
+    preset: Annotated[
+        str | None,
+        typer.Option(help="Named parameter set under --param: default | paper (the paper's own)."),
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -298,6 +302,7 @@ def preprocess(
     The same parameters are the same version: re-running skips the trials already done.
     Example: suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-20;
     suds-exp preprocess --body snake.toml (a marker chain: shape modes of chord angles)
+    suds-exp preprocess --preset paper --name paper (the paper's own processing)
     """
     from suds_exp.preprocess import list_versions, parse_param_items, parse_trial_ids
     from suds_exp.preprocess import preprocess as run_preprocess
@@ -311,25 +316,18 @@ def preprocess(
             shown = frame.drop(columns=["params"]).assign(params_hash=frame.params_hash.str[:12])
             console.print_frame(shown, title="preprocessing versions")
         return
+    common = dict(
+        params=parse_param_items(param or []),
+        trials=parse_trial_ids(trials_),
+        progress=not (quiet or json_),
+        preset=preset,
+    )
     if body is not None:
         from suds_exp.body import load_body, preprocess_body
 
-        result = preprocess_body(
-            store,
-            load_body(body),
-            name,
-            parse_param_items(param or []),
-            parse_trial_ids(trials_),
-            progress=not (quiet or json_),
-        )
+        result = preprocess_body(store, load_body(body), name, **common)
     else:
-        result = run_preprocess(
-            store,
-            name,
-            parse_param_items(param or []),
-            parse_trial_ids(trials_),
-            progress=not (quiet or json_),
-        )
+        result = run_preprocess(store, name, **common)
     if json_:
         console.print_json(result.to_dict())
         return
@@ -375,6 +373,14 @@ def run(
         list[str] | None,
         typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
     ] = None,
+    skip_infeasible: Annotated[
+        bool | None,
+        typer.Option(
+            "--skip-infeasible/--no-skip-infeasible",
+            help="Leave out the (condition, training size) cells the data cannot supply "
+            "instead of refusing the campaign; stored in its definition.",
+        ),
+    ] = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
     backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
     scheduler: Annotated[
@@ -401,6 +407,7 @@ def run(
         test_conditions=test_conditions,
         mode=mode,
         model_params=model_param,
+        skip_infeasible=skip_infeasible,
     )
     summary = run_campaign(
         open_store(db),
@@ -491,6 +498,29 @@ def report(
         console.print_json({"index": str(index), "files": files})
     else:
         console.out.print(f"wrote {index}")
+
+
+@command()
+def findings(
+    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    boot: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
+    seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """The paper's findings F1-F10 measured on a campaign: statistic, value, 95 % bootstrap
+    interval, holds / unclear / fails / not measurable (definitions in the README).
+
+    Example: suds-exp findings paper --json
+    """
+    from suds_exp.analysis.findings import findings as measure
+    from suds_exp.analysis.findings import findings_json, print_findings
+
+    table = measure(open_store(db), name, n_boot=boot, seed=seed)
+    if json_:
+        console.print_json(findings_json(table, name))
+    else:
+        print_findings(table, name)
 
 
 @command()

@@ -67,9 +67,12 @@ VB_COLUMNS = ("vx", "vy", "wz")
 SAMPLE_KEYS = ("trial_id", "frame", "t", "phase", "cycle", *RA_COLUMNS, *DRA_COLUMNS)
 
 
-def sample_columns(k: int) -> list[str]:
-    """The standard samples columns for k passive components, in order."""
-    return [*SAMPLE_KEYS, *RP_COLUMNS[:k], *DRP_COLUMNS[:k], *VB_COLUMNS]
+def sample_columns(k: int, m: int = 2) -> list[str]:
+    """The standard samples columns for k passive components and m actuated values
+    (2 joint angles, or 4 Cartesian values with ``ra_repr="cartesian"``), in order."""
+    ra = [f"ra_{i}" for i in range(1, m + 1)]
+    dra = [f"dra_{i}" for i in range(1, m + 1)]
+    return [*SAMPLE_KEYS[:5], *ra, *dra, *RP_COLUMNS[:k], *DRP_COLUMNS[:k], *VB_COLUMNS]
 
 
 def _gait_k(gait: str) -> float:

@@ -22,6 +22,8 @@ def test_demo_runs_end_to_end_and_is_idempotent(tmp_path, monkeypatch):
     summary = json.loads(first.stdout)
     assert summary["n_trials"] == 60
     assert summary["n_results"] > 0
+    assert [f["id"] for f in summary["findings"]][:3] == ["F1", "F2", "F3"]
+    assert "findings hold" in summary["findings_headline"]
     assert (tmp_path / "reports" / "demo" / "index.html").is_file()
     assert (tmp_path / "reports" / "discrepancy-demo" / "index.html").is_file()
     assert summary["discrepancy_report"] == str(Path("reports/discrepancy-demo/index.html"))
@@ -36,6 +38,7 @@ def test_demo_runs_end_to_end_and_is_idempotent(tmp_path, monkeypatch):
     again = runner.invoke(app, ["demo"])
     assert again.exit_code == 0, again.output
     assert "ingested 0 new trials (60 already stored)" in again.stdout
+    assert "findings on this SMALL campaign" in again.stdout and "F10" in again.stdout
     assert "reports/demo/index.html and reports/discrepancy-demo/index.html" in again.stdout
     assert store.query_df("SELECT count(*) AS n FROM trials").n[0] == 60
     assert store.query_df("SELECT count(*) AS n FROM results").n[0] == summary["n_results"]

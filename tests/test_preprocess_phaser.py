@@ -96,3 +96,33 @@ def test_a_channel_going_round_twice_per_cycle_is_left_out():
     assert phaser.weights_[3] == 0
     channels, theta = with_double(2500, 90)
     assert phase_rms(phaser.transform(channels), theta) < 0.05
+
+
+def unequal_noise(n: int, seed: int):
+    """The oscillator's channels, the first nearly clean, the others 25 times noisier."""
+    channels, theta = oscillator(n, seed, noise=0.0)
+    rng = np.random.default_rng(seed + 1000)
+    return channels + rng.normal(0, 1, channels.shape) * np.array([0.02, 0.5, 0.5]), theta
+
+
+def test_channels_count_by_their_signal_to_noise():
+    """Noisy channels must not drag the phase away from what the clean one gives alone
+    (with equal weights the three-channel phase was about 6 times worse: 0.16 rad)."""
+    train = [unequal_noise(3000, i)[0] for i in range(3)]
+    combined = Phaser().fit(train)
+    alone = Phaser().fit([x[:, :1] for x in train])
+    assert combined.weights_[0] > 0.9
+    for seed in (40, 41):
+        channels, theta = unequal_noise(2500, seed)
+        clean_only = phase_rms(alone.transform(channels[:, :1]), theta)
+        assert phase_rms(combined.transform(channels), theta) < 1.1 * clean_only
+
+
+def test_independent_errors_get_inverse_variance_weights():
+    from suds_exp.preprocess.phaser import min_variance_weights
+
+    w = min_variance_weights(np.diag([1.0, 4.0, 0.5, 9.0]), np.array([True, True, True, False]))
+    np.testing.assert_allclose(w, np.array([1.0, 0.25, 2.0, 0.0]) / 3.25, rtol=1e-5)
+    # a channel that only adds correlated error is left out rather than weighed negatively
+    cov = np.array([[1.0, 1.2], [1.2, 2.0]])
+    assert min_variance_weights(cov, np.array([True, True])).tolist() == [1.0, 0.0]

@@ -1,4 +1,5 @@
-"""Analysis of campaign results: similarity categories, GLM, IQR, sample efficiency, report.
+"""Analysis of campaign results: similarity categories, GLM, IQR, sample efficiency, the
+paper's findings, report.
 
 The labels come from the SQL views of migration 004 (``results_labelled`` and friends);
 every table of the report is also a function returning a DataFrame::
@@ -10,6 +11,7 @@ every table of the report is also a function returning a DataFrame::
 
 from suds_exp.analysis.categories import GAIT_AXIS, LEARNERS, category_table, main_cycles
 from suds_exp.analysis.errors import AnalysisError
+from suds_exp.analysis.findings import FINDINGS, findings, findings_summary, findings_table
 from suds_exp.analysis.glm import glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import campaigns, load_results
@@ -18,6 +20,7 @@ from suds_exp.analysis.spread import iqr_table, slope_table
 from suds_exp.analysis.synthetic import synthetic_results
 
 __all__ = [
+    "FINDINGS",
     "GAIT_AXIS",
     "LEARNERS",
     "AnalysisError",
@@ -26,6 +29,9 @@ __all__ = [
     "category_table",
     "compare_glm",
     "compare_iqr",
+    "findings",
+    "findings_summary",
+    "findings_table",
     "glm_table",
     "iqr_table",
     "iqr_wide",

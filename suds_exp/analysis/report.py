@@ -16,6 +16,7 @@ import pandas as pd
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
 from suds_exp.analysis.errors import AnalysisError
+from suds_exp.analysis.findings import findings_display, findings_headline, findings_table
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
@@ -32,10 +33,13 @@ def report_tables(
     paper_dir: Path | None = None,
     upper_from: int | None = None,
     pairs: str = "same-condition",
+    findings_boot: int = 400,
 ) -> dict[str, pd.DataFrame]:
     """Every table of the report, from labelled results (see `load_results`).
 
-    Keys: ``categories``, ``glm`` (100 ln scale), ``glm_rmse`` (mm/s), ``iqr``, ``slopes``,
+    Keys: ``findings`` (the paper's findings F1-F10, see `findings_table`, with
+    ``findings_boot`` bootstrap replicates), ``categories``, ``glm`` (100 ln scale),
+    ``glm_rmse`` (mm/s), ``iqr``, ``slopes``,
     and, when the paper's tables are found (in ``paper_dir``, which must hold them, or
     else in the default folder, which may not), ``compare_glm``
     (both scales, column ``scale``), ``compare_iqr`` and ``agreement``. A part that the
@@ -44,7 +48,10 @@ def report_tables(
     """
     if pairs not in PAIRS:
         raise AnalysisError(f"--pairs {pairs}: expected one of {', '.join(PAIRS)}")
-    tables: dict[str, pd.DataFrame] = {"categories": category_table(results, n_cycles)}
+    tables: dict[str, pd.DataFrame] = {
+        "findings": findings_table(results, n_boot=findings_boot, upper_from=upper_from),
+        "categories": category_table(results, n_cycles),
+    }
     tables["glm"] = glm_table(results, n_cycles, response="log")
     tables["glm_rmse"] = glm_table(results, n_cycles, response="rmse")
     try:
@@ -94,7 +101,8 @@ _PAIRS_TEXT = {
 }
 
 _NAV = (
-    '<p><a href="#categories">box plots</a> | <a href="#glm">GLM</a> | '
+    '<p><a href="#findings">findings</a> | <a href="#categories">box plots</a> | '
+    '<a href="#glm">GLM</a> | '
     '<a href="#spread">spread</a> | <a href="#efficiency">sample efficiency</a> | '
     '<a href="#paper">beside the paper</a></p>'
 )
@@ -130,7 +138,8 @@ def write_report(
     """Write the report of ``campaign`` into ``out_dir`` (default ``reports/<campaign>``).
 
     Files: ``boxplot_frequency.png``, ``boxplot_gait.png``, ``boxplot_combined.png``,
-    ``sample_efficiency.png``; ``categories``, ``glm``, ``glm_rmse``, ``iqr``, ``slopes``,
+    ``sample_efficiency.png``; ``findings``, ``categories``, ``glm``, ``glm_rmse``, ``iqr``,
+    ``slopes``,
     ``compare_glm``, ``compare_iqr``, ``agreement`` as ``.csv`` and ``.md``; and
     ``index.html``, which shows them all and loads nothing from the network.
 
@@ -172,7 +181,7 @@ def write_report(
     files: dict[str, dict[str, Path]] = {}
     digits = {"compare_iqr": 2, "iqr": 3, "slopes": 3, "agreement": 2}
     for name, frame in tables.items():
-        md = None
+        md = to_markdown(findings_display(frame)) if name == "findings" else None
         if name == "iqr":
             md = "".join(
                 f"### IQR of RMS error of vx (mm/s) at {plots.frequency_name(f)} Hz\n\n"
@@ -182,9 +191,49 @@ def write_report(
         files[name] = write_table(frame, out, name, digits.get(name, 2), md)
 
     page = _page(campaign, store, results, size, tables, figures, files, pairs)
+    page = page.replace(_FINDINGS_SLOT, _findings_html(tables["findings"], files["findings"]), 1)
+    page = page.replace(_SKIPPED_SLOT, _skipped_html(store, campaign), 1)
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")
     return index
+
+
+_FINDINGS_SLOT = "<!-- findings -->"
+_SKIPPED_SLOT = "<!-- skipped cells -->"
+
+
+def _findings_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
+    a = table.attrs
+    return "\n".join(
+        [
+            '<h2 id="findings">The paper\'s findings</h2>',
+            f"<p><b>{html.escape(findings_headline(table))}.</b></p>",
+            '<p class="note">Each of the paper\'s findings (F1-F10; F8 and F9 in parts) as '
+            "one statistic of these results with a 95 % bootstrap interval (draws resampled "
+            f"with every learner paired, seed {a['seed']}). holds: the whole interval is on "
+            "the paper's side of the threshold; unclear: the value is, the interval is not "
+            "all; fails: the value is on the other side; not measurable: the campaign lacks "
+            "the data (reason given). Ratios are of median RMS errors of vx; same-condition "
+            f"pairs at the main size ({a['main_cycles']} cycles) unless said. The README "
+            "defines every statistic.</p>",
+            to_html(findings_display(table)),
+            f"<p>Files (with each statistic's definition): {_files(files)}</p>",
+        ]
+    )
+
+
+def _skipped_html(store: Store, campaign: str) -> str:
+    from suds_exp.campaign.definition import skipped_cells_text
+    from suds_exp.campaign.runner import load_stored_definition
+
+    # Results without a campaign row (e.g. inserted by hand) have nothing left out.
+    text = skipped_cells_text(load_stored_definition(store, campaign) or {})
+    if not text:
+        return ""
+    return (
+        "<p><b>Cells left out</b> (the campaign was run with <code>--skip-infeasible</code>; "
+        f"its data cannot supply them): {html.escape(text)}.</p>"
+    )
 
 
 def _reference_note(refs: dict[str, str]) -> str:
@@ -224,7 +273,9 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         f"learners {esc(models)}; "
         f"training sizes (cycles) {esc(sizes)}. Box plots and GLMs use the {size}-cycle results. "
         f"Written {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.</p>",
+        _SKIPPED_SLOT,
         _NAV,
+        _FINDINGS_SLOT,
         '<h2 id="categories">1. Log RMS error by similarity category</h2>',
         '<p class="note">Gait similarity: steps between training and test gait on the axis '
         "S+, S-, O, D-, D+ (same 0, near 1, far more than 1). Frequency: same or different "

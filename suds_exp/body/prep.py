@@ -53,16 +53,21 @@ def preprocess_body(
     params: Mapping[str, Any] | None = None,
     trials: Iterable[int] | None = None,
     progress: bool = True,
+    preset: str | None = None,
 ) -> PrepResult:
     """Preprocess trials of ``body``: the standard pipeline for the swimmer, else a chain.
 
-    Parameters as `suds_exp.preprocess.preprocess`; ``params["k"]`` is set from the
+    Parameters as `suds_exp.preprocess.preprocess` (a ``preset`` is the swimmer's only);
+    ``params["k"]`` is set from the
     chain's ``modes`` (k = modes - 2). Raises `BodyError` for a description the trials do
     not fit (an unknown marker) or a segment body other than the swimmer (not supported
     yet), `PreprocessError` as the standard pipeline does.
     """
     if body.is_swimmer():
-        return preprocess(store, name, params, trials, progress)
+        return preprocess(store, name, params, trials, progress, preset=preset)
+    if preset is not None:
+        raise BodyError(f"{body.source}: preset {preset!r} describes the swimmer; a "
+                        "chain takes --param only")
     if body.chain is None:
         raise BodyError(
             f"{body.source}: segment bodies other than the swimmer's (11 roles, motors at "

@@ -31,6 +31,7 @@ from suds_exp.campaign.errors import CampaignError
 from suds_exp.robot import SAMPLE_KEYS, VB_COLUMNS
 
 _RP = re.compile(r"^d?rp_\d+$")
+_RA_MORE = re.compile(r"^d?ra_\d+$")
 _TWO_PI = 2.0 * np.pi
 #: A cycle is complete when its samples span 2 pi less at most this many phase steps.
 COMPLETE_SLACK_STEPS = 2.5
@@ -45,7 +46,10 @@ def sample_columns(samples: pd.DataFrame) -> list[str]:
             "the `samples` table (see DESIGN.md)"
         )
     rp = sorted((c for c in samples.columns if _RP.match(str(c))), key=lambda c: (c[0] == "d", c))
-    return [*SAMPLE_KEYS, *rp, *VB_COLUMNS]
+    # r_a beyond the two joint angles (the paper preset's Cartesian values)
+    ra = [c for c in samples.columns if _RA_MORE.match(str(c)) and c not in SAMPLE_KEYS]
+    ra.sort(key=lambda c: (c[0] == "d", int(c.rsplit("_", 1)[1])))
+    return [*SAMPLE_KEYS, *ra, *rp, *VB_COLUMNS]
 
 
 @dataclass(frozen=True)

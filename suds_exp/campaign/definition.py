@@ -23,6 +23,7 @@ from suds_exp.campaign.conditions import (
     select_conditions,
 )
 from suds_exp.campaign.errors import CampaignError
+from suds_exp.campaign.sampling import infeasible_cells
 from suds_exp.robot import LEARNERS
 
 MODES = ("measured", "rollout")
@@ -52,6 +53,10 @@ class CampaignOptions:
         default every condition in the samples.
     mode : str
         ``measured`` or ``rollout``, passed to learners that take `mode` (SUDS ones).
+    skip_infeasible : bool
+        Leave out the (train condition, training cycles) cells the samples cannot supply
+        instead of refusing the campaign (default False); the cells left out are stored in
+        the definition (``skipped_cells``).
     """
 
     prep: str | None = None
@@ -62,6 +67,7 @@ class CampaignOptions:
     train_conditions: str | list[Condition] | None = None
     test_conditions: str | list[Condition] | None = None
     mode: str | None = None
+    skip_infeasible: bool | None = None
 
     @classmethod
     def parse(
@@ -129,6 +135,7 @@ DEFAULTS = CampaignOptions(
     train_conditions=None,
     test_conditions=None,
     mode="measured",
+    skip_infeasible=False,
 )
 
 
@@ -187,6 +194,8 @@ class Plan:
     boots: int
     train_cycles: int
     sweep: list[int]
+    #: (train condition, n_cycles, scope) cells left out (see `enumerate_draws`).
+    skipped: tuple = ()
 
     @property
     def test_cycles(self) -> int:
@@ -224,6 +233,16 @@ def make_plan(
         "test_conditions": [list(c) for c in test],
         "mode": options.mode,
     }
+    skipped: list = []
+    if not isinstance(options.skip_infeasible, bool):
+        raise CampaignError(
+            f"--skip-infeasible: {options.skip_infeasible!r}; expected true or false"
+        )
+    if options.skip_infeasible:
+        # Stored only when asked for, so the definitions of earlier campaigns (which have
+        # no such key) still compare equal when they are continued.
+        stored_options["skip_infeasible"] = True
+        skipped = infeasible_cells(bank, train, test, int(options.train_cycles), sweep)
     definition = {
         "version": DEFINITION_VERSION,
         "options": stored_options,
@@ -232,6 +251,11 @@ def make_plan(
         "decimation": {f"{k:g}": v for k, v in bank.decimation.items()},
         "trials": bank.describe(),
     }
+    if options.skip_infeasible:
+        definition["skipped_cells"] = [
+            {"condition": format_condition(c), "n_cycles": n, "pairs": scope}
+            for c, n, scope in skipped
+        ]
     plan = Plan(
         name=name,
         definition=definition,
@@ -241,6 +265,7 @@ def make_plan(
         boots=int(options.boots),
         train_cycles=int(options.train_cycles),
         sweep=sweep,
+        skipped=tuple(skipped),
     )
     return plan, bank
 
@@ -273,6 +298,15 @@ def differences(stored: dict, new: dict, prefix: str = "") -> list[str]:
 def _short(value) -> str:
     text = json.dumps(value, default=str)
     return text if len(text) <= 60 else text[:57] + "..."
+
+
+def skipped_cells_text(definition: dict) -> str:
+    """The cells a definition leaves out, e.g. ``D-@1 x 48 cycles (same-condition pairs)``
+    (comma-separated); empty when none."""
+    return ", ".join(
+        f"{c['condition']} x {c['n_cycles']} cycles ({c['pairs']} pairs)"
+        for c in definition.get("skipped_cells", [])
+    )
 
 
 def normalise(definition: dict) -> dict:

@@ -13,7 +13,11 @@ Grid:
 - sample-efficiency sweep: for every condition that is both a train and a test condition,
   the same-condition pair (train = test condition, test on a different trial) x `boots`
   draws x every number of training cycles in `sweep` (the value `train_cycles` is the
-  main grid's job already).
+  main grid's job already);
+- skipped cells: a campaign run with ``--skip-infeasible`` leaves out the draws its data
+  cannot supply, named as (train condition, training cycles, scope): scope
+  ``same-condition`` leaves out the same-condition draws of that size, ``all`` every draw
+  training on that condition with that many cycles.
 """
 
 from __future__ import annotations
@@ -93,8 +97,13 @@ def enumerate_draws(
     boots: int,
     train_cycles: int,
     sweep: list[int],
+    skip=(),
 ) -> list[Draw]:
-    """Every draw of the campaign grid (main grid, then the sweep), in a fixed order."""
+    """Every draw of the campaign grid (main grid, then the sweep), in a fixed order.
+
+    ``skip``: (train condition, n_cycles, scope) cells to leave out (see the module
+    docstring); scope is ``same-condition`` or ``all``.
+    """
     draws = [
         Draw(campaign, tr, te, b, train_cycles)
         for tr in train_conditions
@@ -109,4 +118,12 @@ def enumerate_draws(
         if n != train_cycles
         for b in range(boots)
     ]
+    if skip:
+        cells = {(tuple(c), int(n), scope) for c, n, scope in skip}
+        draws = [
+            d
+            for d in draws
+            if (d.train, d.n_cycles, "all") not in cells
+            and not (d.train == d.test and (d.train, d.n_cycles, "same-condition") in cells)
+        ]
     return draws

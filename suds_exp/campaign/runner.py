@@ -41,6 +41,7 @@ from suds_exp.campaign.definition import (
     make_plan,
     merge_stored,
     normalise,
+    skipped_cells_text,
 )
 from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import enumerate_draws
@@ -89,6 +90,8 @@ class RunSummary:
         text += f"; {self.total_jobs - self.remaining} / {self.total_jobs} done"
         if self.interrupted:
             text += "; stopped - run the same command again to continue"
+        if self.extra.get("skipped_cells"):
+            text += "; left out: " + skipped_cells_text(self.extra)
         return text
 
     def to_dict(self) -> dict:
@@ -102,6 +105,7 @@ class RunSummary:
             "remaining": self.remaining,
             "interrupted": self.interrupted,
             "seconds": self.seconds,
+            "skipped_cells": self.extra.get("skipped_cells", []),
         }
 
 
@@ -142,6 +146,7 @@ def pending_chunks(plan: Plan, done: set[tuple], chunk_jobs: int) -> tuple[list[
         plan.boots,
         plan.train_cycles,
         plan.sweep,
+        plan.skipped,
     )
     names = list(plan.models)
     chunks: list[Chunk] = []
@@ -253,13 +258,23 @@ def run_campaign(
                     + (f"; and {len(diff) - 6} more" if len(diff) > 6 else "")
                     + "); continue it with its stored options or choose a new NAME"
                 )
-        check_feasible(bank, plan.train_conditions, plan.test_conditions, _max_cycles(plan))
+        # With --skip-infeasible the plan already left out every cell the data cannot
+        # supply; conditions without any complete cycle are refused either way.
+        needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
+        check_feasible(bank, plan.train_conditions, plan.test_conditions, needs)
         done = finished_keys(store, name)
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
             plan, done, chunk_jobs or _default_chunk(plan, n_workers)
         )
+        if total == 0:
+            raise CampaignError(
+                f"campaign {name!r}: --skip-infeasible left out every cell ("
+                + skipped_cells_text(plan.definition)
+                + "); lower --train-cycles/--sweep"
+            )
         summary = RunSummary(name, total, total - pending, created=stored is None)
+        summary.extra["skipped_cells"] = plan.definition.get("skipped_cells", [])
         _record_start(store, plan, stored is None, total, backend, n_workers, pending)
         if pending:
             _execute(

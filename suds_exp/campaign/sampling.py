@@ -101,10 +101,41 @@ def check_feasible(
                 raise CampaignError(
                     f"{format_condition(cond)}: at most {best} complete training cycles remain "
                     f"outside a test trial of the same condition, but {need} are asked; lower "
-                    "--train-cycles/--sweep or leave the condition out"
+                    "--train-cycles/--sweep, leave the condition out, or pass --skip-infeasible to "
+                    "leave out the (condition, size) cells the data cannot supply"
                 )
         elif need > total:
             raise CampaignError(
                 f"{format_condition(cond)}: {total} complete cycles in all, but {need} are "
-                "asked; lower --train-cycles/--sweep or leave the condition out"
+                "asked; lower --train-cycles/--sweep, leave the condition out, or pass "
+                "--skip-infeasible to leave out the (condition, size) cells the data cannot supply"
             )
+
+
+def infeasible_cells(
+    bank: SampleBank,
+    train_conditions: list[Condition],
+    test_conditions: list[Condition],
+    train_cycles: int,
+    sweep: list[int],
+) -> list[tuple[Condition, int, str]]:
+    """The (train condition, training cycles, scope) cells of the grid whose draws cannot
+    be made, in grid order: scope ``all`` when the condition has fewer complete cycles in
+    all than asked (every draw training on it at that size), ``same-condition`` when only
+    the same-condition draws fail (the test trial leaves too few cycles in the others).
+    Conditions with no complete cycle are not cells: `check_feasible` refuses them."""
+    tests = set(test_conditions)
+    cells = []
+    for cond in train_conditions:
+        trials = bank.trials_of(cond)
+        if not trials:
+            continue
+        total = sum(bank.n_cycles(i) for i in trials)
+        best = total - min(bank.n_cycles(i) for i in trials)
+        sizes = {int(train_cycles)} | ({int(n) for n in sweep} if cond in tests else set())
+        for n in sorted(sizes):
+            if n > total and n == train_cycles:
+                cells.append((cond, n, "all"))
+            elif cond in tests and n > best:
+                cells.append((cond, n, "same-condition"))
+    return cells

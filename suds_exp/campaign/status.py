@@ -7,6 +7,7 @@ from datetime import UTC, datetime
 
 import pandas as pd
 
+from suds_exp.campaign.definition import skipped_cells_text
 from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.lock import run_holder
 from suds_exp.store import Store
@@ -20,7 +21,9 @@ def campaign_status(store: Store, name: str) -> dict:
     total, failed}), ``running`` (whether a run holds the database and works on this
     campaign), ``last_run_started`` (UTC), ``rate_jobs_per_s`` (jobs finished per second
     during the last run, None before any), ``eta_s`` (seconds left at that rate while
-    running, else None).
+    running, else None), ``skipped_cells`` (the (condition, training cycles) cells the
+    campaign leaves out, asked for with ``--skip-infeasible``: list of {condition,
+    n_cycles, pairs}).
     """
     with store.read() as conn:
         raw = conn.connection.driver_connection
@@ -97,6 +100,7 @@ def campaign_status(store: Store, name: str) -> dict:
         "last_run_started": started,
         "rate_jobs_per_s": rate,
         "eta_s": eta,
+        "skipped_cells": definition.get("skipped_cells", []),
     }
 
 
@@ -117,6 +121,11 @@ def print_status(status: dict) -> None:
     elif rate:
         line += f" - not running (last run: {rate:.2f} jobs/s)"
     console.out.print(line)
+    if status.get("skipped_cells"):
+        console.out.print(
+            "left out (--skip-infeasible; the data cannot supply them): "
+            + skipped_cells_text(status)
+        )
 
 
 def _duration(seconds: float | None) -> str:

@@ -85,12 +85,12 @@ import pandas as pd
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
-    DRA_COLUMNS,
     RA_COLUMNS,
     VB_COLUMNS,
     Learner,
     ModelError,
     TimeSeries,
+    actuated_columns,
     as_array,
     check_choice,
     check_float,
@@ -102,15 +102,18 @@ from suds_exp.models.base import (
 from suds_exp.models.mixture import Conditional, fit_mixture, responsibilities
 
 
-def history_features(samples: pd.DataFrame, memory: float) -> np.ndarray:
-    """Where the actuated shape came from: r_a(s) - r_a(s - memory), shape (n, 2), rad.
+def history_features(
+    samples: pd.DataFrame, memory: float, columns: tuple | list = RA_COLUMNS
+) -> np.ndarray:
+    """Where the actuated shape came from: r_a(s) - r_a(s - memory), shape (n, m), in the
+    units of the r_a `columns` (rad for joint angles, mm for the paper's Cartesian values).
 
     s is the arc length travelled in actuated-shape space within each trial (rad), so the
     feature is rate-independent; before a trial has travelled `memory` rad the chord
     reaches back to its first sample. Returned in the caller's row order.
     """
     ts = TimeSeries.of(samples)
-    ra = as_array(samples, RA_COLUMNS, "GMR")[ts.order]
+    ra = as_array(samples, columns, "GMR")[ts.order]
     step = np.linalg.norm(np.diff(ra, axis=0, prepend=ra[:1]), axis=1)
     step[ts.first] = 0.0
     out = np.empty_like(ra)
@@ -119,7 +122,7 @@ def history_features(samples: pd.DataFrame, memory: float) -> np.ndarray:
         # strictly increasing abscissa for interp even where the shape stood still
         s = s + np.arange(b - a) * 1e-12
         back = s - memory
-        for j in range(2):
+        for j in range(ra.shape[1]):
             out[a:b, j] = ra[a:b, j] - np.interp(back, s, ra[a:b, j])
     return ts.unsort(out)
 
@@ -179,7 +182,7 @@ class GMR(Learner):
     Attributes
     ----------
     priors_ (K,), means_ (K, D), covariances_ (K, D, D): the mixture in standardised
-    units over the inputs `columns_in_` (then hist_1, hist_2 with branching="history")
+    units over the inputs `columns_in_` (then hist_1..hist_m with branching="history")
     and the outputs `columns_out_`, rates divided by rho^alpha; `center_`, `scale_` (D,)
     the standardisation; `speed_floor_` (rad/s); `transition_` (K, K) the branch
     transition matrix (None unless branching="filter"); `rp_bounds_` (2, k) rollout
@@ -227,7 +230,8 @@ class GMR(Learner):
     # -- columns -------------------------------------------------------------------------
     def _columns(self, samples):
         """(input columns, output columns, rp columns, drp columns)."""
-        return list(RA_COLUMNS) + list(DRA_COLUMNS), list(VB_COLUMNS), [], []
+        ra, dra = actuated_columns(samples)
+        return ra + dra, list(VB_COLUMNS), [], []
 
     def _validate(self):
         n = self.name
@@ -271,14 +275,16 @@ class GMR(Learner):
         require_columns(samples, ("trial_id", "t", *cin, *cout), self.name)
         self.columns_in_, self.columns_out_ = cin, cout
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
+        self.ra_columns_, self.dra_columns_ = actuated_columns(samples)
         rng = np.random.default_rng(self.random_state)
-        speed = np.linalg.norm(as_array(samples, DRA_COLUMNS, self.name), axis=1)
+        speed = np.linalg.norm(as_array(samples, self.dra_columns_, self.name), axis=1)
         # a robot that mostly stands still has median speed 0: fall back to the mean, then 1
         typical = float(np.median(speed)) or float(np.mean(speed)) or 1.0
         self.speed_floor_ = self.speed_floor * typical
         Xin, f = self._inputs(samples)
         Z = np.hstack([Xin, as_array(samples, cout, self.name) / f[:, None]])
-        names = cin + (["hist_1", "hist_2"] if self.branching == "history" else []) + cout
+        hist = [f"hist_{i + 1}" for i in range(len(self.ra_columns_))]
+        names = cin + (hist if self.branching == "history" else []) + cout
         rate = np.array([c.startswith("d") or c in VB_COLUMNS for c in names])
         self.center_ = Z.mean(axis=0)
         self.scale_ = np.where(Z.std(axis=0) > 0, Z.std(axis=0), 1.0)
@@ -334,9 +340,9 @@ class GMR(Learner):
         """
         X = as_array(samples, self.columns_in_, self.name)
         f = self._homogeneity(samples)
-        X[:, [c in DRA_COLUMNS for c in self.columns_in_]] /= f[:, None]
+        X[:, [c in self.dra_columns_ for c in self.columns_in_]] /= f[:, None]
         if self.branching == "history":
-            X = np.hstack([X, history_features(samples, self.branch_memory)])
+            X = np.hstack([X, history_features(samples, self.branch_memory, self.ra_columns_)])
         return X, f
 
     def _homogeneity(self, samples) -> np.ndarray:
@@ -346,7 +352,7 @@ class GMR(Learner):
         """
         if self.augment != "homogeneous" or self.augment_power == 0:
             return np.ones(len(samples))
-        dra = as_array(samples, DRA_COLUMNS, self.name)
+        dra = as_array(samples, self.dra_columns_, self.name)
         rho = np.sqrt((dra * dra).sum(axis=1) + self.speed_floor_**2)
         return rho**self.augment_power
 
@@ -436,7 +442,8 @@ class GMRSuds(GMR):
         rp, drp = passive_columns(samples)
         if not rp:
             raise ModelError(f"{self.name}: samples frame has no rp_1.. columns (passive shape)")
-        return list(RA_COLUMNS) + rp + list(DRA_COLUMNS), list(VB_COLUMNS) + drp, rp, drp
+        ra, dra = actuated_columns(samples)
+        return ra + rp + dra, list(VB_COLUMNS) + drp, rp, drp
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         self._check_fitted()
@@ -465,20 +472,21 @@ class GMRSuds(GMR):
         ts = TimeSeries.of(samples)
         Xs = ((Xin - self.center_[:d]) / self.scale_[:d])[ts.order]
         fs = f[ts.order]
-        # r_p occupies inputs 2..2+k and outputs 3..3+k; in standardised units one Euler
-        # step is rp_s += dt * drp_s * scale_out / scale_in.
-        gain = self.scale_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
-        off = self.center_[d + 3 : d + 3 + k] / self.scale_[2 : 2 + k]
-        lo = (self.rp_bounds_[0] - self.center_[2 : 2 + k]) / self.scale_[2 : 2 + k]
-        hi = (self.rp_bounds_[1] - self.center_[2 : 2 + k]) / self.scale_[2 : 2 + k]
+        # r_p occupies inputs m..m+k (after the m of r_a) and outputs 3..3+k; in
+        # standardised units one Euler step is rp_s += dt * drp_s * scale_out / scale_in.
+        rp_in = slice(len(self.ra_columns_), len(self.ra_columns_) + k)
+        gain = self.scale_[d + 3 : d + 3 + k] / self.scale_[rp_in]
+        off = self.center_[d + 3 : d + 3 + k] / self.scale_[rp_in]
+        lo = (self.rp_bounds_[0] - self.center_[rp_in]) / self.scale_[rp_in]
+        hi = (self.rp_bounds_[1] - self.center_[rp_in]) / self.scale_[rp_in]
         c = self._cond
         P, mu_in, reg, mu_out = c.prec_in, c.mean_in, c.reg, c.mean_out
         K, q = mu_out.shape
         n = len(Xs)
-        # Only r_p (inputs 2..2+k) changes along the rollout, so everything else of the
+        # Only r_p (inputs m..m+k) changes along the rollout, so everything else of the
         # whitened inputs and of the local means is computed for all samples at once;
         # a step is then two small matrix products: yk = Y0_t + r_p W, m = M0_t + r_p R.
-        rp_idx = np.arange(2, 2 + k)
+        rp_idx = np.arange(rp_in.start, rp_in.stop)
         known = Xs.copy()
         known[:, rp_idx] = 0.0
         Y0 = np.einsum("nd,kde->nke", known, P) - np.einsum("kd,kde->ke", mu_in, P)[None]
@@ -513,5 +521,5 @@ class GMRSuds(GMR):
             a = a / s if s > 0 else pri
             out[t] = a @ (M0[t] + (x @ R).reshape(K, q))
             rp[t] = x
-        rp = rp * self.scale_[2 : 2 + k] + self.center_[2 : 2 + k]
+        rp = rp * self.scale_[rp_in] + self.center_[rp_in]
         return ts.unsort(out * self.scale_[d:] + self.center_[d:]) * f[:, None], ts.unsort(rp)

@@ -1,8 +1,9 @@
 """What every learner shares: reading a samples frame, trials as time series, checks.
 
 A samples frame has the columns of the `samples` table (see DESIGN.md): `trial_id`,
-`t` (s), `phase` (rad, unwrapped), `ra_1`, `ra_2` (rad), `dra_1`, `dra_2` (rad/s),
-`rp_1..rp_k`, `drp_1..drp_k`, `vx`, `vy` (mm/s), `wz` (rad/s), all in the body frame.
+`t` (s), `phase` (rad, unwrapped), `ra_1..ra_m`, `dra_1..dra_m` (m = 2 joint angles,
+rad and rad/s, or the paper preset's Cartesian values, mm and mm/s), `rp_1..rp_k`,
+`drp_1..drp_k`, `vx`, `vy` (mm/s), `wz` (rad/s), all in the body frame.
 Learners never assume the rows are sorted: every time-series operation works on the
 rows ordered by (`trial_id`, `t`) and results are put back in the caller's order.
 """
@@ -20,11 +21,20 @@ from suds_exp.errors import ConfigError, SudsError
 from suds_exp.robot import DRA_COLUMNS, RA_COLUMNS, VB_COLUMNS  # noqa: F401  (also imported from here)
 
 _RP_PATTERN = re.compile(r"^rp_(\d+)$")
+_RA_PATTERN = re.compile(r"^ra_(\d+)$")
 GAP_FACTOR = 5.0
 
 
 class ModelError(SudsError):
     """A samples frame cannot be used by a learner as given (missing column, too few rows)."""
+
+
+def _consecutive(samples: pd.DataFrame, pattern: re.Pattern) -> int:
+    present = {int(m.group(1)) for c in samples.columns if (m := pattern.match(str(c)))}
+    k = 0
+    while k + 1 in present:
+        k += 1
+    return k
 
 
 def passive_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
@@ -33,11 +43,20 @@ def passive_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
     Returns `(["rp_1", ..., "rp_k"], ["drp_1", ..., "drp_k"])`; k is the number of
     consecutive `rp_i` columns starting at 1 (0 when there are none).
     """
-    present = {int(m.group(1)) for c in samples.columns if (m := _RP_PATTERN.match(str(c)))}
-    k = 0
-    while k + 1 in present:
-        k += 1
+    k = _consecutive(samples, _RP_PATTERN)
     return [f"rp_{i}" for i in range(1, k + 1)], [f"drp_{i}" for i in range(1, k + 1)]
+
+
+def actuated_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
+    """Names of the actuated shape columns present, in order.
+
+    Returns `(["ra_1", ..., "ra_m"], ["dra_1", ..., "dra_m"])`; m is the number of
+    consecutive `ra_i` columns starting at 1 (2 joint angles by default, 4 Cartesian
+    values with the paper preset). Without any, the default pair, so that the missing
+    columns are named by `require_columns`.
+    """
+    m = _consecutive(samples, _RA_PATTERN) or len(RA_COLUMNS)
+    return [f"ra_{i}" for i in range(1, m + 1)], [f"dra_{i}" for i in range(1, m + 1)]
 
 
 def require_columns(samples: pd.DataFrame, columns, model: str) -> None:

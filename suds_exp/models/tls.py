@@ -42,12 +42,11 @@ import pandas as pd
 from suds_exp.errors import ConfigError
 from suds_exp.models import fourier
 from suds_exp.models.base import (
-    DRA_COLUMNS,
-    RA_COLUMNS,
     VB_COLUMNS,
     Learner,
     ModelError,
     TimeSeries,
+    actuated_columns,
     as_array,
     check_choice,
     check_float,
@@ -225,10 +224,11 @@ class TLS(Learner):
 
     # -- shared pieces -----------------------------------------------------------------
     def _offsets(self, samples, r, dra):
-        """delta (n, n_r) and delta_dot_a (n, 2) from the mean gait."""
+        """delta (n, n_r) and delta_dot_a (n, m) from the mean gait."""
         phase = samples["phase"].to_numpy(dtype=float)
         rbar = fourier.basis(phase, self.gait_order) @ self.gait_coef_
-        drbar_a = fourier.basis_derivative(phase, self.gait_order) @ self.gait_coef_[:, :2]
+        m = len(self.ra_columns_)
+        drbar_a = fourier.basis_derivative(phase, self.gait_order) @ self.gait_coef_[:, :m]
         return r - rbar, dra - drbar_a * phase_rate(samples)[:, None]
 
     def _coef_at(self, phase):
@@ -240,32 +240,34 @@ class TLS(Learner):
         """The fitted model's terms at the given phases (rad, array of shape (n,)).
 
         Returns a dict of arrays: `C` (n, q); `B` (n, q, n_r) with B[:, i, j] = d out_i /
-        d delta_j; `A` (n, q, 2) with A[:, i, j] = d out_i / d delta_dot_a_j (the
-        connection, e.g. mm/rad for vx); `dA` (n, q, 2, n_r) with dA[:, i, j, l] =
+        d delta_j; `A` (n, q, m) with A[:, i, j] = d out_i / d delta_dot_a_j (the
+        connection, e.g. mm/rad for vx); `dA` (n, q, m, n_r) with dA[:, i, j, l] =
         d A[i, j] / d r_l; `r_bar` (n, n_r). q runs over vx, vy, wz (then dr_p/dt).
         """
         self._check_fitted()
         phase = np.asarray(phase, dtype=float).ravel()
         th = self._coef_at(phase)
-        m = self.gait_coef_.shape[1]
+        m, a = self.gait_coef_.shape[1], len(self.dra_columns_)
         C = th[:, 0, :] + fourier.basis(phase, self.gait_order) @ self.mean_coef_
         B = th[:, 1 : 1 + m, :].transpose(0, 2, 1)
-        A = th[:, 1 + m : 3 + m, :].transpose(0, 2, 1)
-        dA = th[:, 3 + m :, :].reshape(len(phase), m, 2, -1).transpose(0, 3, 2, 1)
+        A = th[:, 1 + m : 1 + m + a, :].transpose(0, 2, 1)
+        dA = th[:, 1 + m + a :, :].reshape(len(phase), m, a, -1).transpose(0, 3, 2, 1)
         rbar = fourier.basis(phase, self.gait_order) @ self.gait_coef_
         return {"C": C, "B": B, "A": A, "dA": dA, "r_bar": rbar}
 
     def fit(self, samples: pd.DataFrame, y=None):
         self._validate()
         rp_cols, drp_cols = self._shape_columns(samples)
+        ra_cols, dra_cols = actuated_columns(samples)
         out_cols = self._output_columns() + drp_cols
-        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *rp_cols, *out_cols)
+        need = ("trial_id", "t", "phase", *ra_cols, *dra_cols, *rp_cols, *out_cols)
         require_columns(samples, need, self.name)
-        r = as_array(samples, list(RA_COLUMNS) + rp_cols, self.name)
-        dra = as_array(samples, DRA_COLUMNS, self.name)
+        r = as_array(samples, ra_cols + rp_cols, self.name)
+        dra = as_array(samples, dra_cols, self.name)
         Y = as_array(samples, out_cols, self.name)
         phase = samples["phase"].to_numpy(dtype=float)
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
+        self.ra_columns_, self.dra_columns_ = ra_cols, dra_cols
 
         self.gait_coef_ = fourier.fit(phase, r, self.gait_order)
         # The phase mean of the outputs (order gait_order) is taken out before binning,
@@ -320,11 +322,19 @@ class TLS(Learner):
         self.bin_coef_ = bin_coef
         self.kept_fraction_ = n_kept / (self.n_bins * q * (p + (self.n_bins > 1)))
         if rp_cols:
-            self.rp_bounds_ = rollout_bounds(r[:, 2:])
+            self.rp_bounds_ = rollout_bounds(r[:, len(ra_cols) :])
         W = fourier.fit(centres, bin_coef.reshape(self.n_bins, -1), self.coef_order)
         self.coef_ = W.reshape(-1, p + 1, q)
         self.n_features_in_ = p
         return self
+
+    def _shape_arrays(self, samples):
+        """r = (r_a, r_p) (n, m + k) and dr_a/dt (n, m) of the fitted columns."""
+        ra, dra = self.ra_columns_, self.dra_columns_
+        need = ("trial_id", "t", "phase", *ra, *dra, *self.rp_columns_)
+        require_columns(samples, need, self.name)
+        r = as_array(samples, ra + self.rp_columns_, self.name)
+        return r, as_array(samples, dra, self.name)
 
     def _predict_measured(self, samples, r, dra):
         delta, ddot = self._offsets(samples, r, dra)
@@ -337,10 +347,7 @@ class TLS(Learner):
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
         self._check_fitted()
-        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *self.rp_columns_)
-        require_columns(samples, need, self.name)
-        r = as_array(samples, list(RA_COLUMNS) + self.rp_columns_, self.name)
-        dra = as_array(samples, DRA_COLUMNS, self.name)
+        r, dra = self._shape_arrays(samples)
         return self._output_frame(self._predict_measured(samples, r, dra), samples)
 
 
@@ -392,12 +399,9 @@ class TLSSuds(TLS):
         check_choice("mode", self.mode, ("measured", "rollout"), self.name)
         if self.mode == "measured":
             return super().predict(samples)
-        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *self.rp_columns_)
-        require_columns(samples, need, self.name)
-        r = as_array(samples, list(RA_COLUMNS) + self.rp_columns_, self.name)
-        dra = as_array(samples, DRA_COLUMNS, self.name)
+        r, dra = self._shape_arrays(samples)
         r = r.copy()
-        r[:, 2:] = self._rollout(samples, r, dra)
+        r[:, len(self.ra_columns_) :] = self._rollout(samples, r, dra)
         return self._output_frame(self._predict_measured(samples, r, dra), samples)
 
     def rollout(self, samples: pd.DataFrame) -> pd.DataFrame:
@@ -406,10 +410,7 @@ class TLSSuds(TLS):
         Uses phase, r_a, dr_a/dt of every sample and r_p of each trial's first sample only.
         """
         self._check_fitted()
-        need = ("trial_id", "t", "phase", *RA_COLUMNS, *DRA_COLUMNS, *self.rp_columns_)
-        require_columns(samples, need, self.name)
-        r = as_array(samples, list(RA_COLUMNS) + self.rp_columns_, self.name)
-        dra = as_array(samples, DRA_COLUMNS, self.name)
+        r, dra = self._shape_arrays(samples)
         return pd.DataFrame(
             self._rollout(samples, r, dra), index=samples.index, columns=self.rp_columns_
         )
@@ -417,15 +418,15 @@ class TLSSuds(TLS):
     def _rollout(self, samples, r, dra):
         """r_p integrated from each trial's first sample, shape (n, k), caller's order."""
         k = len(self.rp_columns_)
-        n = len(r)
+        n, m = len(r), len(self.ra_columns_)
         r0 = r.copy()
-        r0[:, 2:] = 0.0
+        r0[:, m:] = 0.0
         base = self._predict_measured(samples, r0, dra)[:, 3:]  # dr_p/dt at r_p = 0
         # Columns of M: response of dr_p/dt to a unit r_p_i, got by linearity in r_p.
         M = np.empty((n, k, k))
         for i in range(k):
             ri = r0.copy()
-            ri[:, 2 + i] = 1.0
+            ri[:, m + i] = 1.0
             M[:, :, i] = self._predict_measured(samples, ri, dra)[:, 3:] - base
         ts = TimeSeries.of(samples)
         o = ts.order
@@ -437,7 +438,7 @@ class TLSSuds(TLS):
         a_prev = np.concatenate([a[:1], a[:-1]])
         P = lhs_inv @ (eye + h * M_prev)
         c = np.einsum("nij,nj->ni", lhs_inv, h[:, :, 0] * (a + a_prev))
-        rp_meas = r[o, 2:]
+        rp_meas = r[o, m:]
         out = np.empty((n, k))
         first = ts.first
         lo, hi = self.rp_bounds_

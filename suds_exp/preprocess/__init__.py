@@ -4,8 +4,10 @@ stored as named, versioned parameter sets."""
 from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.params import (
     DEFAULTS,
+    PRESETS,
     parse_param_items,
     parse_trial_ids,
+    preset_params,
     resolve_params,
 )
 from suds_exp.preprocess.phaser import Phaser
@@ -17,6 +19,8 @@ from suds_exp.robot import sample_columns
 __all__ = [
     "DEFAULTS",
     "Differentiator",
+
+    "PRESETS",
     "Phaser",
     "PrepResult",
     "PreprocessError",
@@ -27,6 +31,7 @@ __all__ = [
     "parse_param_items",
     "parse_trial_ids",
     "preprocess",
+    "preset_params",
     "resolve_params",
     "sample_columns",
 ]

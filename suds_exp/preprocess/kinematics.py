@@ -19,7 +19,7 @@ from suds_exp.preprocess.body_frame import (
 )
 from suds_exp.preprocess.chain import chain_pose
 from suds_exp.preprocess.params import TAIL_FITS
-from suds_exp.preprocess.shape import PASSIVE_ROLES, actuated_shape, passive_state
+from suds_exp.preprocess.shape import ACTUATED_SHAPES, PASSIVE_ROLES, passive_state
 from suds_exp.robot import ROLES, SPOKE_ROLES
 
 _ROLE = {role: i for i, role in enumerate(ROLES)}
@@ -85,8 +85,9 @@ class Kinematics:
         Body origin in the motion plane.
     heading : array of shape (n_frames,), rad
         Body +X in the motion plane, unwrapped.
-    ra : array of shape (n_frames, 2), rad
-        Actuated shape (phi1, phi2).
+    ra : array of shape (n_frames, m)
+        Actuated shape: (phi1, phi2), rad, or with ``ra_repr="cartesian"`` the four
+        Cartesian values of `suds_exp.preprocess.shape.cartesian_shape`, mm.
     passive : array of shape (n_frames, 12), mm
         Passive state (order `suds_exp.preprocess.shape.PASSIVE_NAMES`).
     """
@@ -98,17 +99,20 @@ class Kinematics:
 
 
 def kinematics(
-    measured: Measured, joints: Joints, chain: tuple[int, int] | None = None
+    measured: Measured,
+    joints: Joints,
+    chain: tuple[int, int] | None = None,
+    ra_repr: str = "angles",
 ) -> Kinematics:
     """Body pose, r_a and passive state of a measured trial given its segment origins.
 
     ``chain``: (window frames, polynomial order) of the relative-angle smoothing of
     `chain_pose`, which then gives the body pose (``xy``, ``heading``); None keeps the pose
     of the segment frames (`body_pose`). r_a and the passive state come from the segment
-    frames either way.
+    frames either way; ``ra_repr`` ("angles" | "cartesian") picks its representation.
     """
     pose = body_pose(measured.frames, joints)
-    ra = actuated_shape(measured.frames, pose)
+    ra = ACTUATED_SHAPES[ra_repr](measured.frames, pose)
     points = {r: measured.local[:, _ROLE[r]] for r, _ in PASSIVE_ROLES}
     passive = passive_state(measured.frames, pose, points)
     xy, heading = pose.xy, pose.heading

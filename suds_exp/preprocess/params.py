@@ -39,6 +39,9 @@ DEFAULTS: dict[str, Any] = {
     "chain_window_s": 0.6,
     "chain_polyorder": 7,
     # shape
+    # r_a as the joint angles (phi1, phi2), rad | cartesian: each outer segment's
+    # top-marker centroid in the body frame (head x, y, tail x, y), mm, as in the paper
+    "ra_repr": "angles",
     "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
     "shape_polyorder": 5,  # its polynomial order
     "k": 4,  # number of passive principal components kept as r_p (1..12)
@@ -66,6 +69,22 @@ BODY_FITS = ("chain", "segments")
 SG_KERNELS = ("triweight", "box")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
+RA_REPRS = ("angles", "cartesian")
+
+#: Named parameter sets over `DEFAULTS` (``suds-exp preprocess --preset NAME``).
+#: ``paper``: the paper's own processing ("Data Processing"): jumps over 9 mm removed and
+#: filled linearly, segment frames from the two top markers only, the body frame from the
+#: segment origins (no chain fit), r_a as Cartesian values, no smoothing of the shape.
+#: Rates still need a differentiator; the paper names none, so the default one is kept.
+PRESETS: dict[str, dict[str, Any]] = {
+    "default": {},
+    "paper": {
+        "ra_repr": "cartesian",
+        "tail_fit": "top",
+        "body_fit": "segments",
+        "shape_window_s": 0.0,
+    },
+}
 
 
 def _coerce(key: str, value: Any) -> Any:
@@ -114,18 +133,34 @@ def _check(params: dict[str, Any]) -> None:
         ("sg_kernel", SG_KERNELS),
         ("phaser_group", PHASER_GROUPS),
         ("phaser_channels", PHASER_CHANNELS),
+        ("ra_repr", RA_REPRS),
     ):
         if params[key] not in choices:
             raise ConfigError(f"--param {key}={params[key]}: expected one of {', '.join(choices)}")
 
 
-def resolve_params(given: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """The full parameter set: ``given`` over `DEFAULTS`, typed and validated.
+def preset_params(preset: str) -> dict[str, Any]:
+    """The parameters a named preset sets over `DEFAULTS` (see `PRESETS`).
 
-    Raises `ConfigError` for an unknown key or a value of the wrong type or range.
+    Raises `ConfigError` for an unknown preset name.
+    """
+    if preset not in PRESETS:
+        choices = ", ".join(PRESETS)
+        raise ConfigError(f"--preset {preset}: unknown preset; expected one of {choices}")
+    return dict(PRESETS[preset])
+
+
+def resolve_params(
+    given: Mapping[str, Any] | None = None, preset: str | None = None
+) -> dict[str, Any]:
+    """The full parameter set: ``given`` over the ``preset`` (if any) over `DEFAULTS`,
+    typed and validated.
+
+    Raises `ConfigError` for an unknown key or preset, or a value of the wrong type or range.
     """
     params = dict(DEFAULTS)
-    for key, value in (given or {}).items():
+    merged = {**(preset_params(preset) if preset is not None else {}), **(given or {})}
+    for key, value in merged.items():
         if key not in DEFAULTS:
             raise ConfigError(
                 f"--param {key}: unknown parameter; expected one of {', '.join(DEFAULTS)}"
@@ -159,3 +194,8 @@ def params_hash(params: Mapping[str, Any]) -> str:
     return hashlib.sha256(params_json(params).encode()).hexdigest()
 
 
+
+
+def actuated_dimension(params: Mapping[str, Any]) -> int:
+    """m, the number of r_a columns of a version with these parameters."""
+    return 4 if params.get("ra_repr", "angles") == "cartesian" else 2

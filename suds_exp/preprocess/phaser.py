@@ -11,9 +11,11 @@ Implemented from the published description:
    S_n = <e^{-i n phi}> over the training data (the protophase-to-phase transform of
    Kralemann et al. 2008, the density form of Phaser's series correction);
 3. the corrected channel phases are aligned by their mean circular offsets and combined
-   with weights given by the first principal component of their unwrapped series
-   (channels whose protophase does not advance at channel 0's rate, within a factor
-   `MAX_RATE_RATIO`, are left out);
+   with the weights of least error variance (`min_variance_weights`), the errors' covariance
+   estimated from what each channel's phase does faster than the cycle
+   (`channel_error_covariance`): each channel counts by its signal to noise, as in the
+   reference implementation. Channels whose protophase does not advance at channel 0's
+   rate, within a factor `MAX_RATE_RATIO`, are left out;
 4. the combined phase gets a final Fourier-series correction of the same kind;
 5. phase zero is a Poincare section: the mean phase at which the first channel crosses
    its mean upwards.
@@ -28,6 +30,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 from scipy.signal import hilbert
 
 from suds_exp.preprocess.errors import PreprocessError
@@ -94,6 +97,80 @@ def _apply_series(phi: np.ndarray, coef: np.ndarray) -> np.ndarray:
     n = np.arange(1, len(coef) + 1)
     terms = np.exp(1j * phi[..., None] * n) * coef
     return phi + (2.0 * terms.imag / n).sum(axis=-1)
+
+
+def channel_error_covariance(thetas: Sequence[np.ndarray], offsets: np.ndarray) -> np.ndarray:
+    """Covariance of the channels' phase errors, estimated from their own records.
+
+    The true phase of an oscillator advances smoothly, so what a channel's corrected phase
+    does faster than the cycle (measurement noise, cycle-to-cycle changes of its waveform,
+    wobble the series correction left) is error: the part of each aligned, unwrapped
+    channel phase that a moving mean over one period removes.
+
+    Parameters
+    ----------
+    thetas : list of arrays of shape (n_frames, n_channels), rad
+        Corrected channel phases of each training record.
+    offsets : array of shape (n_channels,), rad
+        Circular offset of each channel from channel 0.
+
+    Returns
+    -------
+    array of shape (n_channels, n_channels), rad^2
+    """
+    n_ch = len(offsets)
+    acc, count = np.zeros((n_ch, n_ch)), 0
+    for th in thetas:
+        aligned = np.unwrap(th[:, 0])[:, None] + _wrap(th - offsets - th[:, :1])
+        advance = aligned[-1, 0] - aligned[0, 0]
+        if advance <= 0:
+            continue
+        half = int(TWO_PI / advance * (len(th) - 1)) // 2
+        if len(th) <= 4 * half + 1:
+            continue
+        # an odd window, so a steady ramp passes unchanged; ends (biased by the filter's
+        # edge handling) left out
+        mean = uniform_filter1d(aligned, 2 * half + 1, axis=0, mode="nearest")
+        resid = (aligned - mean)[half + 1 : len(th) - half - 1]
+        acc += resid.T @ resid
+        count += len(resid)
+    if count == 0:
+        return np.eye(n_ch)
+    return acc / count
+
+
+def min_variance_weights(cov: np.ndarray, keep: np.ndarray, ridge: float = 1e-6) -> np.ndarray:
+    """Weights (sum 1, >= 0) of the combination of channel phases with the least error variance.
+
+    Minimises w' C w subject to sum(w) = 1 over the kept channels: w = C^-1 1 / 1' C^-1 1,
+    the inverse-variance weights when the errors are independent, so each channel counts
+    by its signal to noise (Revzen & Guckenheimer 2008 weigh channels by their z-scored
+    amplitude for the same reason). Channels whose weight would be negative are dropped one
+    at a time (a negative weight bets on a correlation that new data need not repeat).
+
+    Parameters
+    ----------
+    cov : array of shape (n_channels, n_channels), rad^2
+    keep : bool array of shape (n_channels,)
+    ridge : float
+        Added to the diagonal as a fraction of its mean, so duplicated channels stay
+        solvable.
+
+    Returns
+    -------
+    array of shape (n_channels,), 0 for the channels left out
+    """
+    active = np.flatnonzero(keep)
+    while True:
+        c = cov[np.ix_(active, active)]
+        c = c + ridge * max(float(np.trace(c)) / len(active), 1e-300) * np.eye(len(active))
+        w = np.linalg.solve(c, np.ones(len(active)))
+        if np.all(w >= 0) or len(active) == 1:
+            break
+        active = np.delete(active, int(np.argmin(w)))
+    out = np.zeros(len(keep))
+    out[active] = np.abs(w) / np.abs(w).sum()
+    return out
 
 
 class Phaser:
@@ -167,27 +244,19 @@ class Phaser:
         self.offsets_ = np.array(
             [_circmean(alltheta[:, k] - alltheta[:, 0]) for k in range(alltheta.shape[1])]
         )
-        # first principal component of the aligned, unwrapped channel phases
-        unwrapped = []
-        for th in thetas:
-            base = np.unwrap(th[:, 0])
-            aligned = base[:, None] + _wrap(th - self.offsets_ - th[:, :1])
-            unwrapped.append(aligned - aligned.mean(axis=0))
-        u = np.concatenate(unwrapped)
-        _, vectors = np.linalg.eigh(u.T @ u)
-        w = np.abs(vectors[:, -1])
         # a channel that does not go round once per cycle of channel 0 (a flipper opening
         # twice per cycle, a channel with no oscillation) carries no usable phase
         rate = np.array(
             [
                 np.mean([np.unwrap(p[:, k])[-1] - np.unwrap(p[:, k])[0] for p in proto])
-                for k in range(len(w))
+                for k in range(allphi.shape[1])
             ]
         )
         ratio = rate / rate[0] if rate[0] > 0 else np.ones_like(rate)
         self.channel_ok_ = (ratio > 1 / MAX_RATE_RATIO) & (ratio < MAX_RATE_RATIO)
-        w = np.where(self.channel_ok_, w, 0.0)
-        self.weights_ = w / w.sum()
+        self.weights_ = min_variance_weights(
+            channel_error_covariance(thetas, self.offsets_), self.channel_ok_
+        )
         combined = [self._combine(th) for th in thetas]
         self.final_series_ = _series_coefficients(_wrap(np.concatenate(combined)), order)
         # Poincare section: channel 0 crossing its mean upwards

@@ -198,8 +198,16 @@ def _concat_frames(items: list[_Trial]) -> SegmentFrames:
     )
 
 
+#: Phaser channel order of the Cartesian r_a (head x, head y, tail x, tail y): the y values
+#: first, since Phaser's channel 0 sets the Poincare section and the reference rate, and a
+#: segment's x (cos of its angle) goes round twice per gait cycle.
+_CARTESIAN_PHASER_ORDER = [1, 3, 0, 2]
+
+
 def _phaser_input(tr: _Trial, pca: PassivePCA, params: dict) -> np.ndarray:
     ra, passive = _smoothed(tr, params)
+    if params.get("ra_repr", "angles") == "cartesian":
+        ra = ra[:, _CARTESIAN_PHASER_ORDER]
     if params["phaser_channels"] == "ra+rp":
         return np.column_stack([ra, pca.transform(passive)])
     return ra
@@ -231,11 +239,11 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
         "t": tr.t,
         "phase": phase,
         "cycle": cycles(phase).astype(np.int32),
-        "ra_1": ra[:, 0],
-        "ra_2": ra[:, 1],
-        "dra_1": dra[:, 0],
-        "dra_2": dra[:, 1],
     }
+    for i in range(ra.shape[1]):
+        cols[f"ra_{i + 1}"] = ra[:, i]
+    for i in range(ra.shape[1]):
+        cols[f"dra_{i + 1}"] = dra[:, i]
     for i in range(len(RP_COLUMNS)):
         cols[RP_COLUMNS[i]] = rp[:, i] if i < k else np.full(n, np.nan)
         cols[DRP_COLUMNS[i]] = drp[:, i] if i < k else np.full(n, np.nan)
@@ -299,6 +307,7 @@ def preprocess(
     params: Mapping[str, Any] | None = None,
     trials: Iterable[int] | None = None,
     progress: bool = True,
+    preset: str | None = None,
 ) -> PrepResult:
     """Create or reuse the preprocessing version of ``params`` and fill its samples.
 
@@ -314,6 +323,9 @@ def preprocess(
         Trial ids to process (default: every trial in the store).
     progress : bool
         Show progress bars on stderr.
+    preset : str, optional
+        A named parameter set (`suds_exp.preprocess.params.PRESETS`: ``default``,
+        ``paper``) under ``params``.
 
     Returns
     -------
@@ -323,7 +335,7 @@ def preprocess(
     gap longer than ``max_gap_s``; `ConfigError` for a bad parameter.
     """
     started = time.perf_counter()
-    params = resolve_params(params)
+    params = resolve_params(params, preset)
     digest = params_hash(params)
     wanted = None if trials is None else sorted({int(i) for i in trials})
     v = prep_versions.c
@@ -391,7 +403,7 @@ def preprocess(
         joints = {tr.id: fit_joints(tr.measured.frames) for tr in items}
     for tr in items:
         chain = chain_settings(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
-        tr.kin = kinematics(tr.measured, joints[tr.id], chain)
+        tr.kin = kinematics(tr.measured, joints[tr.id], chain, params["ra_repr"])
     if ("pca", "") in fits:
         pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
     else:

@@ -46,6 +46,26 @@ def actuated_shape(frames: SegmentFrames, pose: BodyPose) -> np.ndarray:
     return np.unwrap(np.stack([phi1, phi2], axis=1), axis=0)
 
 
+def cartesian_shape(frames: SegmentFrames, pose: BodyPose) -> np.ndarray:
+    """r_a as Cartesian values (the paper: "We used cartesian values rather than angles to
+    represent the pose"): each outer segment's top-marker centroid in the body frame.
+
+    Returns an array of shape (n_frames, 4), mm: head x, head y, tail x, tail y (body
+    frame: origin midway between the motor axes, +X towards the head).
+    """
+    c, s = np.cos(pose.heading), np.sin(pose.heading)
+
+    def in_body(p):
+        d = p - pose.xy
+        return np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=1)
+
+    return np.hstack([in_body(frames.head_origin), in_body(frames.tail_origin)])
+
+
+#: r_a of each representation (preprocessing parameter ``ra_repr``).
+ACTUATED_SHAPES = {"angles": actuated_shape, "cartesian": cartesian_shape}
+
+
 def passive_state(
     frames: SegmentFrames, pose: BodyPose, points: dict[str, np.ndarray]
 ) -> np.ndarray:

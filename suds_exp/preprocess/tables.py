@@ -77,4 +77,6 @@ samples = sa.Table(
     sa.Column("vx", sa.Float, nullable=False),
     sa.Column("vy", sa.Float, nullable=False),
     sa.Column("wz", sa.Float, nullable=False),
+    # migration 011: the Cartesian r_a's last two values (NULL for joint angles)
+    *(sa.Column(c, sa.Float) for c in ("ra_3", "ra_4", "dra_3", "dra_4")),
 )

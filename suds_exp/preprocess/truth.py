@@ -36,7 +36,8 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
 
     Columns: ``trial_id`` (``-1`` = all trials pooled), ``gait``, ``frequency_hz``,
     ``n``, ``rms_vx_true`` (mm/s), ``err_vx``, ``err_vy`` (mm/s), ``err_wz`` (rad/s),
-    ``err_ra`` (rad), ``err_phase`` (rad), and ``err_vx_band``, ``err_vy_band``,
+    ``err_ra`` (rad; NaN for a version with r_a as Cartesian values), ``err_phase`` (rad),
+    and ``err_vx_band``, ``err_vy_band``,
     ``err_wz_band``: the body-velocity errors against the truth pose passed through the
     version's own differentiator, i.e. what the markers and the body frame cost, without
     the truth's content above the differentiator's band. Trials without a truth file are
@@ -48,6 +49,8 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
     source = dict(zip(files.id, files.source_file, strict=True))
     rate = dict(zip(files.id, files.sample_rate_hz, strict=True))
     rows, pooled = [], []
+    # r_a as Cartesian values (mm) has no joint angles to compare: err_ra is NaN then
+    no_angles = np.nan if params.get("ra_repr", "angles") != "angles" else 0.0
     for tid, s in samples.groupby("trial_id", sort=True):
         path = truth_path(source[tid])
         if not path.is_file():
@@ -63,8 +66,8 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
                 "vx": s.vx.to_numpy() - truth.vx.to_numpy(),
                 "vy": s.vy.to_numpy() - truth.vy.to_numpy(),
                 "wz": s.wz.to_numpy() - truth.wz.to_numpy(),
-                "ra1": s.ra_1.to_numpy() - truth.phi1.to_numpy(),
-                "ra2": s.ra_2.to_numpy() - truth.phi2.to_numpy(),
+                "ra1": s.ra_1.to_numpy() - truth.phi1.to_numpy() + no_angles,
+                "ra2": s.ra_2.to_numpy() - truth.phi2.to_numpy() + no_angles,
                 "phase": _phase_error(s.phase.to_numpy(), truth.phase_cmd.to_numpy()),
                 "vx_band": s.vx.to_numpy() - band[:, 0],
                 "vy_band": s.vy.to_numpy() - band[:, 1],

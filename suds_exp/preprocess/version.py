@@ -18,6 +18,7 @@ import pandas as pd
 import sqlalchemy as sa
 
 from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.preprocess.params import actuated_dimension
 from suds_exp.preprocess.phaser import Phaser
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.shape import PassivePCA
@@ -117,7 +118,7 @@ def load_samples(
     with store.read() as conn:
         require_tables(conn)
         row = find_version_row(conn, version)
-        cols = sample_columns(row.k)
+        cols = sample_columns(row.k, actuated_dimension(json.loads(row.params)))
         select = ", ".join(f's."{c}"' for c in cols)
         where = "s.version_id = ?"
         args: list[Any] = [row.id]
