@@ -50,7 +50,7 @@ def truth_errors(store: Store, version: int | str) -> pd.DataFrame:
     rate = dict(zip(files.id, files.sample_rate_hz, strict=True))
     rows, pooled = [], []
     # r_a as Cartesian values (mm) has no joint angles to compare: err_ra is NaN then
-    no_angles = np.nan if params.get("ra_repr", "angles") != "angles" else 0.0
+    no_angles = np.nan if prep.params.get("ra_repr", "angles") != "angles" else 0.0
     for tid, s in samples.groupby("trial_id", sort=True):
         path = truth_path(source[tid])
         if not path.is_file():
