@@ -65,6 +65,8 @@ def one_run(effect: str | None, seed: int) -> dict:
         "hit": (first is not None and first["effect"] == effect and covers and halved)
         if effect
         else not named,
+        # a learned correction added (the null control must not discover anything)
+        "discovered": bool(res.discovery is not None and res.discovery.significant),
         "workflow_seconds": res.seconds,
         "total_seconds": time.perf_counter() - started,
     }
@@ -162,6 +164,20 @@ def default_timing(seed: int = 0) -> dict:
     }
 
 
+def run_plan(plan, out: Path, key: str, run) -> pd.DataFrame:
+    """Run ``run(effect, seed)`` for each planned pair not yet in ``out`` (column ``key``
+    holds the effect, "none" for None), appending each row as it finishes."""
+    done = pd.read_csv(out) if out.exists() else pd.DataFrame()
+    have = set(zip(done.get(key, []), done.get("seed", []), strict=False))
+    for effect, seed in plan:
+        if ((effect or "none"), seed) in have:
+            continue
+        row = run(effect, seed)
+        print(row, flush=True)
+        pd.DataFrame([row]).to_csv(out, mode="a", header=not out.exists(), index=False)
+    return pd.read_csv(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3, help="seeds per hidden effect")
@@ -176,36 +192,17 @@ def main() -> None:
     )
     args = ap.parse_args()
     if args.withheld:
-        done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
-        have = set(zip(done.get("withheld", []), done.get("seed", []), strict=False))
-        for effect in args.effects.split(","):
-            for seed in (100 + s for s in range(args.seeds)):
-                if (effect, seed) in have:
-                    continue
-                row = withheld_run(effect, seed)
-                print(row, flush=True)
-                pd.DataFrame([row]).to_csv(
-                    args.out, mode="a", header=not args.out.exists(), index=False
-                )
-        table = pd.read_csv(args.out)
+        # seed-major: an interrupted run still covers every effect
+        plan = [(e, 100 + s) for s in range(args.seeds) for e in args.effects.split(",")]
+        table = run_plan(plan, args.out, "withheld", withheld_run)
         print("\nwithheld effects (hidden in the data, excluded from the candidates)")
         print(withheld_summary(table).to_string(index=False))
         print(f"median workflow time per run {table['workflow_seconds'].median():.1f} s")
         return
     if not args.timing_only:
-        done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
-        have = set(zip(done.get("hidden", []), done.get("seed", []), strict=False))
         plan = [(e, 100 + s) for e in args.effects.split(",") for s in range(args.seeds)]
         plan += [(None, 500 + s) for s in range(args.null_seeds)]
-        for effect, seed in plan:
-            if ((effect or "none"), seed) in have:
-                continue
-            row = one_run(effect, seed)
-            print(row, flush=True)
-            pd.DataFrame([row]).to_csv(
-                args.out, mode="a", header=not args.out.exists(), index=False
-            )
-        table = pd.read_csv(args.out)
+        table = run_plan(plan, args.out, "hidden", one_run)
         print("\nconfusion matrix (rows: hidden effect, columns: first named; counts of seeds)")
         print(pd.crosstab(table["hidden"], table["first_named"]).to_string())
         eff = table[table["hidden"] != "none"]
@@ -216,6 +213,9 @@ def main() -> None:
             print(f"overall hit rate {eff['hit'].mean():.3f} over {len(eff)} runs")
         if len(null):
             print(f"null control: nothing named in {null['hit'].mean():.3f} of {len(null)} seeds")
+            if "discovered" in null:
+                clean = (~null["discovered"].fillna(False).astype(bool)).mean()
+                print(f"null control: no correction discovered in {clean:.3f} of {len(null)} seeds")
         print(f"median workflow time per run {table['workflow_seconds'].median():.1f} s")
     if not args.no_timing:
         runs = [default_timing(seed) for seed in range(args.timing_repeats)]
