@@ -1,7 +1,8 @@
 -- Discovery: the sparse learned correction fitted when no named effect explains a
 -- systematic gap (suds_exp/discrepancy/discover.py). One row per run step where it was
 -- tried, and one row per term of the correction. A correction is added to the model
--- (the run's final model plus these terms) only when `significant`.
+-- (the run's final model plus these terms) only when `significant`; that step's
+-- discrepancy_steps.decision is then `discovered`.
 
 CREATE TABLE discrepancy_discoveries (
     run_id INTEGER NOT NULL,
