@@ -119,3 +119,34 @@ def test_bad_options_are_one_line_errors_and_leave_the_database(inertia_db, args
     lines = [x for x in res.output.splitlines() if x.strip()]
     assert len(lines) == 1 and words in lines[0], res.output
     assert _digest(inertia_db) == before
+
+
+def _synthetic(rng, signal: float):
+    """Windows of a residual that is ``signal`` times one feature, plus noise."""
+    from suds_exp.discrepancy.features import Feature
+
+    n_win, n_s, n_f = 24, 80, 6
+    X = rng.normal(size=(n_win, n_s, n_f))
+    feats = [Feature(f"f{i}", "mm/s^2", "acceleration") for i in range(n_f)]
+    sim = rng.normal(size=(n_win, n_s, 3))
+    meas = sim + rng.normal(scale=0.5, size=sim.shape)
+    meas[..., 0] += signal * X[..., 2]
+    trial_id = np.repeat(np.arange(12), 2)
+    return X, feats, sim, meas, trial_id
+
+
+@pytest.mark.parametrize("signal", [0.0, 1.0])
+def test_discovery_recovers_a_term_and_discovers_nothing_in_noise(signal):
+    from suds_exp.discrepancy.discover import discover
+
+    X, feats, sim, meas, trial_id = _synthetic(np.random.default_rng(7), signal)
+    d = discover(
+        X, feats, sim, meas, np.ones(3), trial_id, range(6), ("vx", "vy", "wz"), 0.01, 0.05
+    )
+    if signal == 0:
+        assert not d.significant and d.terms == [] and d.physics == ""
+        return
+    assert d.significant and d.physics == "inertia" and d.leading[0] == "f2"
+    (term,) = [t for t in d.terms if t.channel == "vx"]
+    assert term.ci[0] <= 1.0 <= term.ci[1] and term.unit == "mm/s / (mm/s^2)"
+    assert d.improvement > 0.5
