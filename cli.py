@@ -547,6 +547,18 @@ def discrepancy(
     out: Annotated[
         Path | None, typer.Option(help="Report folder (default: reports/discrepancy-NAME).")
     ] = None,
+    exclude_candidates: Annotated[
+        str | None,
+        typer.Option(help="Comma list of effects never offered as candidates."),
+    ] = None,
+    discover: Annotated[
+        bool,
+        typer.Option(
+            "--discover/--no-discover",
+            help="Fit a sparse learned correction when no candidate explains a systematic gap.",
+        ),
+    ] = True,
+    max_terms: Annotated[int, typer.Option(help="Most terms per channel of that correction.")] = 4,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -557,17 +569,28 @@ def discrepancy(
     Example: suds-exp discrepancy --model-effect flippers=absent --max-effects 2
     """
     from suds_exp.discrepancy import DiscrepancyOptions, parse_trial_ids, run_discrepancy
+    from suds_exp.discrepancy.discover import DiscoverySettings
+    from suds_exp.discrepancy.workflow import parse_exclude
     from suds_exp.sim.commands import build_config
 
     start = build_config(model, model_effect or [])
     say = (lambda line: None) if (quiet or json_) else console.err.print
+    # options are checked before the database is opened
+    options = DiscrepancyOptions(
+        alpha=alpha,
+        max_effects=max_effects,
+        seed=seed,
+        exclude=parse_exclude(exclude_candidates),
+        discover=discover,
+        discovery=DiscoverySettings(max_terms=max_terms),
+    )
     result = run_discrepancy(
         open_store(db),
         prep,
         start,
         name=name,
         trials=parse_trial_ids(trials),
-        options=DiscrepancyOptions(alpha=alpha, max_effects=max_effects, seed=seed),
+        options=options,
         out=out,
         default_out=Path("reports"),
         log=say,
@@ -581,6 +604,9 @@ def discrepancy(
             f"{n['unit']} {n['ci']} (p_adj {n['p_adjusted']:.2g}); "
             f"held-out loss {n['gap_before']:.4g} -> {n['gap_after']:.4g}"
         )
+    if result.discovery is not None:
+        for line in result.discovery.equations():
+            console.out.print(f"learned correction: {line}")
     console.out.print(result.outcome)
     console.out.print(f"report: {result.report_dir}")
 

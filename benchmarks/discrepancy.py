@@ -8,6 +8,12 @@ interval covers the true value and the held-out gap at least halves.
 
     .venv/bin/python benchmarks/discrepancy.py --seeds 3 --null-seeds 4 --out bench-disc.csv
     .venv/bin/python benchmarks/discrepancy.py --timing-only     # default dataset timing
+    .venv/bin/python benchmarks/discrepancy.py --withheld --seeds 5 --out bench-withheld.csv
+
+`--withheld`: each effect is hidden in the data AND excluded from the candidates
+(`--exclude-candidates`); per effect it prints the wrong-name rate (anything named), the
+rate at which the gap is reported as unexplained by the library, the held-out gap closed
+by the discovered correction, and its leading features.
 
 Rows are appended to --out as runs finish, so an interrupted benchmark keeps its results
 (and a re-run skips the rows already there).
@@ -60,9 +66,84 @@ def one_run(effect: str | None, seed: int) -> dict:
         "hit": (first is not None and first["effect"] == effect and covers and halved)
         if effect
         else not named,
+        # a learned correction added (the null control must not discover anything)
+        "discovered": bool(res.discovery is not None and res.discovery.significant),
         "workflow_seconds": res.seconds,
         "total_seconds": time.perf_counter() - started,
     }
+
+
+#: Physics the discovered term should resemble when an effect is withheld (simple forms).
+EXPECTED_PHYSICS = {
+    "body_inertia": "inertia",
+    "hinge_damping": "damping",
+    "medium_compaction": "compaction",
+    "asymmetric_drag": "asymmetric drag",
+}
+
+
+def withheld_run(effect: str, seed: int) -> dict:
+    """Hide ``effect`` and exclude it from the candidates; what does the workflow say?"""
+    from suds_exp.discrepancy import DiscrepancyOptions
+
+    rng = np.random.default_rng(seed)
+    hidden = {effect: draw_hidden(effect, rng)}
+    started = time.perf_counter()
+    opts = DiscrepancyOptions(seed=seed, exclude=(effect,))
+    res = hidden_effect_run(hidden, seed=seed, options=opts, **DESIGN).result
+    d = res.discovery
+    return {
+        "withheld": effect,
+        "seed": seed,
+        "truth": run_truth(hidden, effect),
+        "named": ";".join(n["candidate"] for n in res.named) or "nothing",
+        "wrong_name": bool(res.named),
+        "unexplained": d is not None,
+        "discovered": bool(d is not None and d.significant),
+        "gap_before": res.gap_before,
+        "gap_model": res.gap_after,
+        "gap_corrected": res.gap_after_correction,
+        "gap_closed_by_term": d.improvement if d is not None else 0.0,
+        "p_term": d.p_value if d is not None else None,
+        "physics": d.physics if d is not None else "",
+        "expected": EXPECTED_PHYSICS.get(effect, ""),
+        "leading": ";".join(d.leading[:3]) if d is not None else "",
+        "equations": " | ".join(d.equations()) if d is not None else "",
+        "workflow_seconds": res.seconds,
+        "total_seconds": time.perf_counter() - started,
+    }
+
+
+def run_truth(hidden: dict, effect: str) -> float:
+    _, param = HIDDEN[effect]
+    return float(hidden[effect][param])
+
+
+def withheld_summary(table: pd.DataFrame) -> pd.DataFrame:
+    """Per withheld effect: seeds, wrong-name rate, unexplained rate, gap closed by the
+    discovered term (median; 0 when none was added), physics-match rate, leading features."""
+    rows = []
+    for effect, g in table.groupby("withheld"):
+        closed = np.where(g["discovered"], g["gap_closed_by_term"], 0.0)
+        lead = g["leading"].fillna("").str.split(";").str[0]
+        rows.append(
+            {
+                "withheld": effect,
+                "seeds": len(g),
+                "wrong_name_rate": g["wrong_name"].mean(),
+                "unexplained_rate": g["unexplained"].mean(),
+                "added_rate": g["discovered"].mean(),
+                "median_gap_closed": float(np.median(closed)),
+                "closed_ge_50pct": float(np.mean(closed >= 0.5)),
+                "physics_match": float((g["physics"] == g["expected"]).mean())
+                if g["expected"].fillna("").ne("").all()
+                else np.nan,
+                "leading_features": ", ".join(
+                    f"{k} ({v})" for k, v in lead[lead != ""].value_counts().items()
+                ),
+            }
+        )
+    return pd.DataFrame(rows)
 
 
 def default_timing(seed: int = 0) -> dict:
@@ -84,6 +165,20 @@ def default_timing(seed: int = 0) -> dict:
     }
 
 
+def run_plan(plan, out: Path, key: str, run) -> pd.DataFrame:
+    """Run ``run(effect, seed)`` for each planned pair not yet in ``out`` (column ``key``
+    holds the effect, "none" for None), appending each row as it finishes."""
+    done = pd.read_csv(out) if out.exists() else pd.DataFrame()
+    have = set(zip(done.get(key, []), done.get("seed", []), strict=False))
+    for effect, seed in plan:
+        if ((effect or "none"), seed) in have:
+            continue
+        row = run(effect, seed)
+        print(row, flush=True)
+        pd.DataFrame([row]).to_csv(out, mode="a", header=not out.exists(), index=False)
+    return pd.read_csv(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3, help="seeds per hidden effect")
@@ -93,21 +188,22 @@ def main() -> None:
     ap.add_argument("--timing-only", action="store_true")
     ap.add_argument("--no-timing", action="store_true")
     ap.add_argument("--timing-repeats", type=int, default=1, help="default-dataset runs")
+    ap.add_argument(
+        "--withheld", action="store_true", help="hide each effect and exclude it from candidates"
+    )
     args = ap.parse_args()
+    if args.withheld:
+        # seed-major: an interrupted run still covers every effect
+        plan = [(e, 100 + s) for s in range(args.seeds) for e in args.effects.split(",")]
+        table = run_plan(plan, args.out, "withheld", withheld_run)
+        print("\nwithheld effects (hidden in the data, excluded from the candidates)")
+        print(withheld_summary(table).to_string(index=False))
+        print(f"median workflow time per run {table['workflow_seconds'].median():.1f} s")
+        return
     if not args.timing_only:
-        done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
-        have = set(zip(done.get("hidden", []), done.get("seed", []), strict=False))
         plan = [(e, 100 + s) for e in args.effects.split(",") for s in range(args.seeds)]
         plan += [(None, 500 + s) for s in range(args.null_seeds)]
-        for effect, seed in plan:
-            if ((effect or "none"), seed) in have:
-                continue
-            row = one_run(effect, seed)
-            print(row, flush=True)
-            pd.DataFrame([row]).to_csv(
-                args.out, mode="a", header=not args.out.exists(), index=False
-            )
-        table = pd.read_csv(args.out)
+        table = run_plan(plan, args.out, "hidden", one_run)
         print("\nconfusion matrix (rows: hidden effect, columns: first named; counts of seeds)")
         print(pd.crosstab(table["hidden"], table["first_named"]).to_string())
         eff = table[table["hidden"] != "none"]
@@ -118,6 +214,9 @@ def main() -> None:
             print(f"overall hit rate {eff['hit'].mean():.3f} over {len(eff)} runs")
         if len(null):
             print(f"null control: nothing named in {null['hit'].mean():.3f} of {len(null)} seeds")
+            if "discovered" in null:
+                clean = (~null["discovered"].fillna(False).astype(bool)).mean()
+                print(f"null control: no correction discovered in {clean:.3f} of {len(null)} seeds")
         print(f"median workflow time per run {table['workflow_seconds'].median():.1f} s")
     if not args.no_timing:
         runs = [default_timing(seed) for seed in range(args.timing_repeats)]

@@ -3,6 +3,7 @@ fit and test the simulator's named effects as candidates, name the one that sign
 closes the held-out gap, add it and repeat."""
 
 from suds_exp.discrepancy.demo import demo_discrepancy, draw_hidden, hidden_effect_run
+from suds_exp.discrepancy.discover import Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, parse_effect_items
 from suds_exp.discrepancy.errors import DiscrepancyError
 from suds_exp.discrepancy.replay import ReplaySettings
@@ -10,6 +11,7 @@ from suds_exp.discrepancy.select import FitSettings
 from suds_exp.discrepancy.workflow import (
     DiscrepancyOptions,
     DiscrepancyResult,
+    parse_exclude,
     parse_trial_ids,
     run_discrepancy,
 )
@@ -19,6 +21,8 @@ __all__ = [
     "DiscrepancyError",
     "DiscrepancyOptions",
     "DiscrepancyResult",
+    "Discovery",
+    "DiscoverySettings",
     "FitSettings",
     "ReplaySettings",
     "candidates_for",
@@ -26,6 +30,7 @@ __all__ = [
     "draw_hidden",
     "hidden_effect_run",
     "parse_effect_items",
+    "parse_exclude",
     "parse_trial_ids",
     "run_discrepancy",
 ]

@@ -110,4 +110,49 @@ def record_run(store, result, options, started_at: _dt.datetime) -> int:
         loc = pd.concat(loc_frames, ignore_index=True)
         loc.insert(0, "run_id", run_id)
         store.insert_df(conn, "discrepancy_localisation", loc)
+        _record_discoveries(store, conn, run_id, result)
     return run_id
+
+
+def _record_discoveries(store, conn, run_id: int, result) -> None:
+    """Rows of discrepancy_discoveries and discrepancy_correction_terms (migration 007)."""
+    runs, terms = [], []
+    for s in result.steps:
+        d = s.discovery
+        if d is None:
+            continue
+        runs.append(
+            {
+                "run_id": run_id,
+                "step": s.index,
+                "significant": bool(d.significant),
+                "p_value": _num(d.p_value),
+                "test_loss_before": _num(np.mean(d.test_before)),
+                "test_loss_after": _num(np.mean(d.test_after)),
+                "gap_closed": _num(d.improvement),
+                "physics": d.physics,
+                "leading_features": json.dumps(d.leading),
+                "equations": json.dumps(d.equations()),
+                "n_features": len(d.features),
+                "seconds": float(d.seconds),
+            }
+        )
+        for t in d.terms:
+            terms.append(
+                {
+                    "run_id": run_id,
+                    "step": s.index,
+                    "channel": t.channel,
+                    "feature": t.feature.name,
+                    "family": t.feature.family,
+                    "unit": t.unit,
+                    "coefficient": float(t.coef),
+                    "ci_low": _num(t.ci[0]),
+                    "ci_high": _num(t.ci[1]),
+                    "weight": _num(t.weight),
+                }
+            )
+    if runs:
+        store.insert_df(conn, "discrepancy_discoveries", pd.DataFrame(runs))
+    if terms:
+        store.insert_df(conn, "discrepancy_correction_terms", pd.DataFrame(terms))

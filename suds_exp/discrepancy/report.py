@@ -163,6 +163,71 @@ def _fig_candidates(result, path: Path) -> None:
     plt.close(fig)
 
 
+def _discovery_table(d) -> pd.DataFrame:
+    return pd.DataFrame(
+        [
+            {
+                "channel": t.channel,
+                "feature": t.feature.name,
+                "family": t.feature.family,
+                "coefficient": t.coef,
+                "ci_low": t.ci[0],
+                "ci_high": t.ci[1],
+                "unit": t.unit,
+                "share": t.weight,
+            }
+            for t in d.terms
+        ],
+        columns=[
+            "channel",
+            "feature",
+            "family",
+            "coefficient",
+            "ci_low",
+            "ci_high",
+            "unit",
+            "share",
+        ],
+    )
+
+
+def _fig_discovery(d, path: Path) -> None:
+    fig, ax = plt.subplots(figsize=(9, 3.4))
+    x = np.arange(len(d.test_trials))
+    ax.bar(x - 0.2, d.test_before, width=0.4, label="model")
+    ax.bar(x + 0.2, d.test_after, width=0.4, label="model + learned correction")
+    ax.set_xticks(x, [str(int(t)) for t in d.test_trials], rotation=60, fontsize=7)
+    ax.set_xlabel("held-out trial")
+    ax.set_ylabel("loss (normalised)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def _discovery_parts(result, out: Path) -> list[str]:
+    """The learned-correction section (empty when no correction was tried)."""
+    d = result.steps[-1].discovery
+    if d is None:
+        return []
+    table = _discovery_table(d)
+    table.to_csv(out / "correction.csv", index=False)
+    (out / "correction.md").write_text(_md(table) if not table.empty else "(no term)\n")
+    _fig_discovery(d, out / "discovery.png")
+    verdict = "added to the model" if d.significant else "not added (held-out test failed)"
+    return [
+        "<h2>Learned correction (no named effect explains the gap)</h2>",
+        f"<p>{html.escape(verdict)}: held-out loss {np.mean(d.test_before):.4g} -> "
+        f"{np.mean(d.test_after):.4g} ({d.improvement:.0%} closed, p = {d.p_value:.2g}); "
+        f"resembles <b>{html.escape(d.physics or 'nothing')}</b>; leading features "
+        f"{html.escape(', '.join(d.leading[:3]))}.</p>",
+        "<pre>" + html.escape("\n".join(d.equations()) or "(no term)") + "</pre>",
+        table.to_html(index=False, float_format=lambda v: f"{v:.4g}") if not table.empty else "",
+        "<h3>Held-out loss per trial, with and without the correction</h3>"
+        "<img src='discovery.png' width='100%'>",
+    ]
+
+
 def write_report(result, out: Path) -> Path:
     """Write the report of ``result`` (a `DiscrepancyResult`) into ``out``; return ``out``."""
     out.mkdir(parents=True, exist_ok=True)
@@ -224,6 +289,7 @@ def write_report(result, out: Path) -> Path:
             last.correlations.head(15).to_html(index=False, float_format=lambda v: f"{v:.3f}"),
         ]
         last.correlations.to_csv(out / "correlations.csv", index=False)
+    parts += _discovery_parts(result, out)
     for fname, caption, draw in figures:
         draw(out / fname)
         if (out / fname).exists():

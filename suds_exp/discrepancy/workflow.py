@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from suds_exp.discrepancy.effects import Candidate, candidates_for
+from suds_exp.discrepancy.discover import Discovery, DiscoverySettings, discover
+from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
 from suds_exp.discrepancy.errors import DiscrepancyError
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
 from suds_exp.discrepancy.replay import (
@@ -69,6 +70,14 @@ class DiscrepancyOptions:
         Held-out loss (mean squared residual over each channel's mean square, so 0.01 is
         a residual of about 10% of the signal) below which a remaining gap is called
         negligible even when it is statistically systematic.
+    exclude : tuple of str
+        Effects never offered as candidates (``--exclude-candidates``): the withheld-effect
+        checks hide an effect in the data and exclude it here.
+    discover : bool
+        When no candidate is significant and a systematic gap above ``gap_floor``
+        remains, fit a sparse learned correction (`discover.py`) on the training trials
+        and add it if it passes its own held-out test at ``alpha``.
+    discovery : DiscoverySettings
     """
 
     alpha: float = 0.01
@@ -79,6 +88,17 @@ class DiscrepancyOptions:
     refine: bool = True
     passive: bool = True
     gap_floor: float = 0.01
+    exclude: tuple[str, ...] = ()
+    discover: bool = True
+    discovery: DiscoverySettings = field(default_factory=DiscoverySettings)
+
+    def __post_init__(self) -> None:
+        self.exclude = parse_exclude(",".join(self.exclude))
+        if not self.discover and set(effect_names()) <= set(self.exclude):
+            raise DiscrepancyError(
+                "--exclude-candidates: every candidate is excluded and discovery is off; "
+                "nothing could explain the gap"
+            )
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -102,6 +122,7 @@ class Step:
     systematic: tuple[float, float] = (float("nan"), 1.0)
     correlations: pd.DataFrame | None = None
     example: dict | None = None
+    discovery: Discovery | None = None
 
 
 @dataclass
@@ -159,6 +180,18 @@ class DiscrepancyResult:
         """Held-out loss of the final model."""
         return self.steps[-1].test_loss
 
+    @property
+    def discovery(self) -> Discovery | None:
+        """The sparse correction fitted at the last step (None when none was tried)."""
+        return self.steps[-1].discovery
+
+    @property
+    def gap_after_correction(self) -> float:
+        """Held-out loss of the final model with the learned correction when it was
+        added (significant), else `gap_after`."""
+        d = self.discovery
+        return float(np.mean(d.test_after)) if d is not None and d.significant else self.gap_after
+
     def to_json(self) -> dict:
         last = self.steps[-1]
         return {
@@ -198,6 +231,8 @@ class DiscrepancyResult:
                 }
                 for s in self.steps
             ],
+            "discovery": discovery_json(self.discovery),
+            "gap_after_correction": self.gap_after_correction,
             "outcome": self.outcome,
             "seconds": self.seconds,
             "cpu_seconds": self.cpu_seconds,
@@ -205,6 +240,47 @@ class DiscrepancyResult:
             "train_trials": self.train_trials,
             "test_trials": self.test_trials,
         }
+
+
+def discovery_json(d: Discovery | None) -> dict | None:
+    """The learned correction as plain data (None when none was tried)."""
+    if d is None:
+        return None
+    return {
+        "significant": d.significant,
+        "p_value": d.p_value,
+        "gap_before": float(np.mean(d.test_before)),
+        "gap_after": float(np.mean(d.test_after)),
+        "gap_closed": d.improvement,
+        "physics": d.physics,
+        "leading": d.leading,
+        "equations": d.equations(),
+        "terms": [
+            {
+                "channel": t.channel,
+                "feature": t.feature.name,
+                "family": t.feature.family,
+                "coef": t.coef,
+                "ci": list(t.ci),
+                "unit": t.unit,
+            }
+            for t in d.terms
+        ],
+    }
+
+
+def parse_exclude(text: str | None) -> tuple[str, ...]:
+    """``"body_inertia,hinge_damping"`` -> a tuple of effect names, each checked."""
+    if text is None or not text.strip():
+        return ()
+    names = effect_names()
+    out = tuple(x.strip() for x in text.split(",") if x.strip())
+    for x in out:
+        if x not in names:
+            raise DiscrepancyError(
+                f"--exclude-candidates {x!r}: unknown effect; expected one of {', '.join(names)}"
+            )
+    return out
 
 
 def split_trials(info: pd.DataFrame, rng: np.random.Generator) -> tuple[list[int], list[int]]:
@@ -261,6 +337,27 @@ def _scales(meas: np.ndarray) -> np.ndarray:
 
 def _rmse(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
     return np.sqrt(np.nanmean((sim - meas) ** 2, axis=(0, 1)))
+
+
+def _discover(full, samples, sim, meas, scales, train_ids, opts, rng) -> Discovery:
+    """The sparse correction of the current replay ``sim`` (no new replay)."""
+    from suds_exp.discrepancy.features import feature_library
+
+    X, feats = feature_library(full, samples, sim)
+    return discover(
+        X,
+        feats,
+        sim,
+        meas,
+        scales,
+        full.trial_id,
+        train_ids,
+        full.channels,
+        opts.alpha,
+        opts.fit.min_improvement,
+        opts.discovery,
+        rng,
+    )
 
 
 def run_discrepancy(
@@ -395,7 +492,7 @@ def run_discrepancy(
         if len(accepted_effects) >= opts.max_effects:
             step.decision = "max_effects"
             break
-        offered = candidates_for(current, exclude=accepted_effects)
+        offered = candidates_for(current, exclude=accepted_effects | set(opts.exclude))
         probe = train.subset(train_ids[:1])
         cands = []
         for c in offered:
@@ -426,6 +523,18 @@ def run_discrepancy(
                     t_all[is_test],
                     full.info[is_test].reset_index(drop=True),
                 )
+                if opts.discover:
+                    step.discovery = _discover(
+                        full, samples, sim, meas_all, scales, train_ids, opts, rng
+                    )
+                    d = step.discovery
+                    say(
+                        f"  discovered correction ({'added' if d.significant else 'not added'}, "
+                        f"p {d.p_value:.2g}): held-out loss {np.mean(d.test_before):.4g} -> "
+                        f"{np.mean(d.test_after):.4g}; leading {', '.join(d.leading[:3])}"
+                    )
+                    if d.significant:
+                        step.decision = "discovered"
             break
         best = max(significant, key=lambda r: r.improvement)
         if opts.refine and best.candidate.param is not None:
@@ -454,7 +563,15 @@ def run_discrepancy(
 
     last = steps[-1]
     named = [s.accepted.candidate.label for s in steps if s.accepted]
-    if last.correlations is not None:
+    d = last.discovery
+    if d is not None and d.significant:
+        outcome = (
+            ("named " + ", ".join(named) + "; then " if named else "")
+            + "a systematic gap no candidate explains; learned correction "
+            f"({d.physics or 'no term'}: {', '.join(d.leading[:3])}) closes "
+            f"{d.improvement:.0%} of the held-out gap"
+        )
+    elif last.correlations is not None:
         top = last.correlations.head(3)
         outcome = (
             "a systematic gap remains that no candidate explains; residual correlates most with "

@@ -1,0 +1,288 @@
+"""Discovery: a sparse learned correction for the gap no named effect explains.
+
+The correction is additive on each replayed channel (body velocity vx, vy, wz and, when
+compared, the passive-shape coordinates r_p):
+
+    channel_model = channel_replay + sum_j xi_j * feature_j
+
+with the features of `features.feature_library`. It reuses the one replay of the current
+model (no replay per feature): the target is the replay's residual, measured minus
+replayed, divided by the channel's loss scale. Per channel:
+
+1. the features are scaled by their RMS over the training samples; orthogonal matching
+   pursuit (scikit-learn) gives the nested supports of 1..``max_terms`` terms;
+2. the number of terms is chosen by grouped cross-validation over the training trials
+   (folds hold whole trials), the fewest terms whose error is within one standard error
+   of the best (0 terms is a candidate: "no correction");
+3. the chosen support is re-fitted by least squares on all training trials, and its
+   coefficients get a percentile interval from a bootstrap over training trials.
+
+The correction is then judged like a named effect, on the held-out trials only: the
+one-sided paired t-test over held-out trials that the relative loss reduction exceeds
+``min_improvement``, at ``alpha``. A correction that fails it is reported but not added.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import stats
+from sklearn.linear_model import orthogonal_mp
+from sklearn.model_selection import GroupKFold
+
+from suds_exp.discrepancy.errors import DiscrepancyError
+from suds_exp.discrepancy.features import PHYSICS, Feature, channel_unit
+from suds_exp.discrepancy.select import trial_losses
+
+
+@dataclass(frozen=True)
+class DiscoverySettings:
+    """Hyper-parameters of the sparse correction.
+
+    Parameters
+    ----------
+    max_terms : int
+        Largest number of terms per channel.
+    n_folds : int
+        Grouped cross-validation folds over training trials (at most one per trial).
+    one_se : bool
+        Choose the fewest terms within one standard error of the best CV error.
+    n_boot : int
+        Bootstrap replicates over training trials for the coefficient intervals.
+    level : float
+        Confidence level of those intervals.
+    """
+
+    max_terms: int = 4
+    n_folds: int = 5
+    one_se: bool = True
+    n_boot: int = 200
+    level: float = 0.95
+
+    def __post_init__(self) -> None:
+        if self.max_terms < 1:
+            raise DiscrepancyError(f"--max-terms {self.max_terms}: must be >= 1")
+
+
+@dataclass
+class Term:
+    """One term of the correction: ``coef * feature`` added to ``channel``."""
+
+    channel: str
+    feature: Feature
+    coef: float
+    ci: tuple[float, float]
+    weight: float  # |coef| * feature RMS / channel loss scale: the term's share
+
+    @property
+    def unit(self) -> str:
+        """Unit of the coefficient: channel unit per feature unit."""
+        cu, fu = channel_unit(self.channel), self.feature.unit
+        return cu if fu == "-" else f"{cu} / ({fu})"
+
+
+@dataclass
+class Discovery:
+    """A fitted correction and its held-out verdict (losses are per held-out trial)."""
+
+    channels: tuple[str, ...]
+    features: list[Feature]
+    coef: np.ndarray  # (n_channels, n_features), physical units; 0 off the support
+    terms: list[Term] = field(default_factory=list)
+    cv_terms: dict = field(default_factory=dict)  # channel -> chosen number of terms
+    test_trials: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    test_before: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    test_after: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    p_value: float = 1.0
+    significant: bool = False
+    seconds: float = 0.0
+
+    @property
+    def improvement(self) -> float:
+        """Fraction of the held-out loss the correction removes."""
+        before = float(np.mean(self.test_before)) if len(self.test_before) else 0.0
+        return 1.0 - float(np.mean(self.test_after)) / before if before > 0 else 0.0
+
+    @property
+    def leading(self) -> list[str]:
+        """Feature names by total share over channels, largest first."""
+        share: dict[str, float] = {}
+        for t in self.terms:
+            if t.feature.family != "constant":
+                share[t.feature.name] = share.get(t.feature.name, 0.0) + t.weight
+        return sorted(share, key=share.get, reverse=True)
+
+    @property
+    def physics(self) -> str:
+        """What the leading term most resembles (`features.PHYSICS`), '' with no term."""
+        lead = self.leading
+        if not lead:
+            return ""
+        fam = next(t.feature.family for t in self.terms if t.feature.name == lead[0])
+        return PHYSICS.get(fam, fam)
+
+    def equations(self) -> list[str]:
+        """One line per corrected channel, e.g. ``vx += -0.19 [-0.21, -0.17] s * dv_x/dt``."""
+        lines = []
+        for ch in self.channels:
+            terms = [t for t in self.terms if t.channel == ch]
+            if not terms:
+                continue
+            parts = [
+                f"{t.coef:+.4g} [{t.ci[0]:.3g}, {t.ci[1]:.3g}] {t.unit}"
+                + ("" if t.feature.name == "1" else f" * {t.feature.name}")
+                for t in terms
+            ]
+            lines.append(f"{ch} ({channel_unit(ch)}) += " + " ".join(parts))
+        return lines
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """The correction, (..., n_channels) in the channels' units, from features
+        (..., n_features); NaN features of unused columns do not matter."""
+        used = np.flatnonzero(np.any(self.coef != 0, axis=0))
+        out = np.zeros(X.shape[:-1] + (len(self.channels),))
+        if len(used):
+            out = np.einsum("...f,cf->...c", X[..., used], self.coef[:, used])
+        return out
+
+
+def _support_path(X: np.ndarray, y: np.ndarray, max_terms: int) -> list[np.ndarray]:
+    """Nested OMP supports of 1..max_terms columns of (already scaled) X."""
+    k = min(max_terms, X.shape[1], max(len(y) - 1, 1))
+    path = orthogonal_mp(X, y, n_nonzero_coefs=k, return_path=True)
+    path = path.reshape(X.shape[1], -1)
+    return [np.flatnonzero(path[:, j]) for j in range(path.shape[1])]
+
+
+def _lstsq(X: np.ndarray, y: np.ndarray, support: np.ndarray) -> np.ndarray:
+    coef = np.zeros(X.shape[1])
+    if len(support):
+        coef[support] = np.linalg.lstsq(X[:, support], y, rcond=None)[0]
+    return coef
+
+
+def _choose_terms(X, y, groups, settings: DiscoverySettings) -> np.ndarray:
+    """Support chosen by grouped CV over the number of terms (see the module docstring)."""
+    n_groups = len(np.unique(groups))
+    folds = min(settings.n_folds, n_groups)
+    if folds < 2:
+        return np.zeros(0, int)
+    errs = np.full((folds, settings.max_terms + 1), np.nan)
+    for i, (tr, va) in enumerate(GroupKFold(n_splits=folds).split(X, y, groups)):
+        errs[i, 0] = np.mean(y[va] ** 2)
+        for j, sup in enumerate(_support_path(X[tr], y[tr], settings.max_terms)):
+            coef = _lstsq(X[tr], y[tr], sup)
+            errs[i, j + 1] = np.mean((y[va] - X[va] @ coef) ** 2)
+    filled = ~np.all(np.isnan(errs), axis=0)
+    mean = np.where(filled, np.nanmean(np.where(np.isnan(errs), np.inf, errs), axis=0), np.inf)
+    best = int(np.argmin(mean))
+    k = best
+    if settings.one_se:
+        se = np.nanstd(errs[:, best]) / np.sqrt(folds)
+        k = int(np.flatnonzero(mean <= mean[best] + se)[0])
+    if k == 0:
+        return np.zeros(0, int)
+    path = _support_path(X, y, k)
+    return path[min(k, len(path)) - 1]
+
+
+def _boot_intervals(X, y, groups, support, settings: DiscoverySettings, rng):
+    """Percentile intervals of the support's coefficients over trial bootstraps."""
+    trials, inv = np.unique(groups, return_inverse=True)
+    Xs = X[:, support]
+    G = np.zeros((len(trials), len(support), len(support)))
+    b = np.zeros((len(trials), len(support)))
+    np.add.at(G, inv, Xs[:, :, None] * Xs[:, None, :])
+    np.add.at(b, inv, Xs * y[:, None])
+    w = rng.multinomial(len(trials), np.full(len(trials), 1 / len(trials)), size=settings.n_boot)
+    reps = []
+    for wi in w:
+        A = np.tensordot(wi, G, axes=1)
+        try:
+            reps.append(np.linalg.solve(A, wi @ b))
+        except np.linalg.LinAlgError:
+            continue
+    reps = np.asarray(reps).reshape(-1, len(support))
+    tail = (1 - settings.level) / 2
+    return np.quantile(reps, tail, axis=0), np.quantile(reps, 1 - tail, axis=0)
+
+
+def discover(
+    X: np.ndarray,
+    features: list[Feature],
+    sim: np.ndarray,
+    meas: np.ndarray,
+    scales: np.ndarray,
+    trial_id: np.ndarray,
+    train_trials,
+    channels: tuple[str, ...],
+    alpha: float,
+    min_improvement: float,
+    settings: DiscoverySettings | None = None,
+    rng: np.random.Generator | None = None,
+) -> Discovery:
+    """Fit the sparse correction on training trials and test it on the others.
+
+    Parameters
+    ----------
+    X : array (n_windows, n_samples, n_features)
+        `feature_library` of the windows.
+    sim, meas : arrays (n_windows, n_samples, n_channels)
+        The current model's replay and the measurement (channels as `replay`).
+    scales : array (n_channels,)
+        Loss scales of the channels (the workflow's).
+    trial_id : array (n_windows,)
+    train_trials : ids of the training trials; every other window is held out.
+    channels : names of the channels.
+    alpha, min_improvement : the held-out test's level and margin (as for candidates).
+    """
+    started = time.perf_counter()
+    s = settings or DiscoverySettings()
+    rng = rng or np.random.default_rng(0)
+    n_win, n_s, n_f = X.shape
+    is_train = np.isin(trial_id, np.asarray(list(train_trials)))
+    groups_all = np.repeat(trial_id, n_s)
+    flat_X = X.reshape(-1, n_f)
+    target = ((meas - sim) / scales).reshape(-1, len(channels))
+    row_train = np.repeat(is_train, n_s)
+    ok = row_train & np.all(np.isfinite(flat_X), axis=1) & np.all(np.isfinite(target), axis=1)
+    rms = np.sqrt(np.mean(flat_X[ok] ** 2, axis=0))
+    usable = rms > 0
+    Xs = np.where(usable, flat_X / np.where(usable, rms, 1.0), 0.0)
+    coef = np.zeros((len(channels), n_f))
+    terms = []
+    chosen = {}
+    for c, ch in enumerate(channels):
+        Xc, yc, gc = Xs[ok][:, usable], target[ok, c], groups_all[ok]
+        support_u = _choose_terms(Xc, yc, gc, s)
+        support = np.flatnonzero(usable)[support_u]
+        chosen[ch] = len(support)
+        if not len(support):
+            continue
+        xi = _lstsq(Xs[ok], yc, support)
+        lo, hi = _boot_intervals(Xs[ok], yc, gc, support, s, rng)
+        for j, f in enumerate(support):
+            to_phys = scales[c] / rms[f]
+            coef[c, f] = xi[f] * to_phys
+            a, b = sorted((lo[j] * to_phys, hi[j] * to_phys))
+            terms.append(Term(ch, features[f], coef[c, f], (a, b), abs(xi[f])))
+    out = Discovery(tuple(channels), features, coef, terms, chosen)
+    test = ~is_train
+    corrected = sim[test] + np.nan_to_num(out.predict(X[test]))
+    trials, loss = trial_losses(
+        np.stack([sim[test], corrected]), meas[test], scales, trial_id[test]
+    )
+    out.test_trials, out.test_before, out.test_after = trials, loss[0], loss[1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = 1.0 - loss[1] / loss[0]
+    if not terms or len(d) < 2 or not np.all(np.isfinite(d)):
+        out.p_value = 1.0
+    elif np.allclose(d, d[0]):
+        out.p_value = 0.0 if d[0] > min_improvement else 1.0
+    else:
+        out.p_value = float(stats.ttest_1samp(d, min_improvement, alternative="greater").pvalue)
+    out.significant = out.p_value < alpha
+    out.seconds = time.perf_counter() - started
+    return out

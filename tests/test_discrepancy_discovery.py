@@ -1,0 +1,152 @@
+"""Discovery: the sparse learned correction when no library candidate explains the gap.
+
+Through the CLI and the SQL tables, on data simulated with body inertia the model lacks
+(simulate -> QTM files -> ingest -> preprocess). Excluding every candidate keeps the
+fast test cheap (one replay, no candidate fits) and is exactly the case the branch is
+for: nothing in the library may explain the gap.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cli import app
+from suds_exp.discrepancy.demo import simulate_measured
+from suds_exp.discrepancy.effects import effect_names
+from suds_exp.sim.config import SimConfig
+from suds_exp.store import Store
+
+runner = CliRunner()
+SMALL = dict(gaits=("S+", "D+"), frequencies_hz=(0.5, 1.0), repeats=3, cycles=(3, 4))
+
+
+@pytest.fixture(scope="module")
+def inertia_db(tmp_path_factory) -> Path:
+    work = tmp_path_factory.mktemp("withheld")
+    truth = SimConfig()
+    truth.effects.body_inertia.tau_s = 0.3
+    simulate_measured(work, truth, seed=5, **SMALL)
+    return work / "suds.duckdb"
+
+
+@pytest.fixture(scope="module")
+def unexplained_run(inertia_db, tmp_path_factory):
+    out = tmp_path_factory.mktemp("report") / "disc"
+    res = runner.invoke(
+        app,
+        [
+            "discrepancy",
+            "--db",
+            str(inertia_db),
+            "--out",
+            str(out),
+            "--exclude-candidates",
+            ",".join(effect_names()),
+            "--name",
+            "withheld-all",
+            "--json",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    return json.loads(res.stdout), out
+
+
+def test_unexplained_gap_is_discovered_as_an_inertia(unexplained_run):
+    doc, _ = unexplained_run
+    assert doc["named"] == []
+    d = doc["discovery"]
+    assert d is not None, doc["outcome"]
+    assert d["significant"], d
+    assert d["gap_closed"] >= 0.5, d
+    assert d["physics"] == "inertia", d
+    assert doc["gap_after_correction"] < 0.5 * doc["gap_before"]
+    # the body relaxes towards the quasi-static velocity: v ~ v_qs - tau dv_qs/dt
+    vx_acc = [t for t in d["terms"] if t["channel"] == "vx" and t["feature"] == "a_x"]
+    assert vx_acc and vx_acc[0]["coef"] < 0 and vx_acc[0]["unit"] == "mm/s / (mm/s^2)"
+    assert "learned correction" in doc["outcome"]
+
+
+def test_unexplained_gap_rows_are_stored(unexplained_run, inertia_db):
+    doc, out = unexplained_run
+    store = Store(inertia_db)
+    steps = store.query_df(
+        "SELECT step, decision, n_candidates, systematic_p, correlations FROM discrepancy_steps "
+        "WHERE run_id = ?",
+        [doc["run_id"]],
+    )
+    assert steps.decision.tolist() == ["discovered"]
+    assert steps.n_candidates.tolist() == [0]
+    assert steps.systematic_p.iloc[0] < 0.01 and steps.correlations.iloc[0]
+    disc = store.query_df("SELECT * FROM discrepancy_discoveries WHERE run_id = ?", [doc["run_id"]])
+    assert len(disc) == 1 and bool(disc.significant.iloc[0])
+    assert disc.physics.iloc[0] == "inertia"
+    assert np.isclose(disc.gap_closed.iloc[0], doc["discovery"]["gap_closed"])
+    assert json.loads(disc.equations.iloc[0]) == doc["discovery"]["equations"]
+    terms = store.query_df(
+        "SELECT channel, feature, coefficient, ci_low, ci_high FROM discrepancy_correction_terms "
+        "WHERE run_id = ? ORDER BY channel, feature",
+        [doc["run_id"]],
+    )
+    assert len(terms) == len(doc["discovery"]["terms"]) > 0
+    assert (terms.ci_low <= terms.coefficient).all() and (terms.coefficient <= terms.ci_high).all()
+    page = (out / "index.html").read_text()
+    assert "Learned correction" in page and "discovery.png" in page
+    assert (out / "correction.csv").exists()
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--exclude-candidates", "body_inertia,warp_drive"], "warp_drive"),
+        (["--exclude-candidates", ",".join(effect_names()), "--no-discover"], "every candidate"),
+        (["--max-terms", "0"], "--max-terms"),
+    ],
+)
+def test_bad_options_are_one_line_errors_and_leave_the_database(inertia_db, args, words):
+    before = _digest(inertia_db)
+    res = runner.invoke(app, ["discrepancy", "--db", str(inertia_db), *args])
+    assert res.exit_code == 2, res.output
+    lines = [x for x in res.output.splitlines() if x.strip()]
+    assert len(lines) == 1 and words in lines[0], res.output
+    assert _digest(inertia_db) == before
+
+
+def _synthetic(rng, signal: float):
+    """Windows of a residual that is ``signal`` times one feature, plus noise."""
+    from suds_exp.discrepancy.features import Feature
+
+    n_win, n_s, n_f = 24, 80, 6
+    X = rng.normal(size=(n_win, n_s, n_f))
+    feats = [Feature(f"f{i}", "mm/s^2", "acceleration") for i in range(n_f)]
+    sim = rng.normal(size=(n_win, n_s, 3))
+    meas = sim + rng.normal(scale=0.5, size=sim.shape)
+    meas[..., 0] += signal * X[..., 2]
+    trial_id = np.repeat(np.arange(12), 2)
+    return X, feats, sim, meas, trial_id
+
+
+@pytest.mark.parametrize("signal", [0.0, 1.0])
+def test_discovery_recovers_a_term_and_discovers_nothing_in_noise(signal):
+    from suds_exp.discrepancy.discover import discover
+
+    X, feats, sim, meas, trial_id = _synthetic(np.random.default_rng(7), signal)
+    d = discover(
+        X, feats, sim, meas, np.ones(3), trial_id, range(6), ("vx", "vy", "wz"), 0.01, 0.05
+    )
+    if signal == 0:
+        assert not d.significant and d.terms == [] and d.physics == ""
+        return
+    assert d.significant and d.physics == "inertia" and d.leading[0] == "f2"
+    (term,) = [t for t in d.terms if t.channel == "vx"]
+    assert term.ci[0] <= 1.0 <= term.ci[1] and term.unit == "mm/s / (mm/s^2)"
+    assert d.improvement > 0.5
