@@ -195,8 +195,10 @@ def main() -> None:
         elif name in ABLATION:
             plan[name] = ABLATION[name]
         else:
-            raise SystemExit(f"--settings: unknown {name!r}; expected search, ablation, "
-                             f"or one of {', '.join(ABLATION)}")
+            raise SystemExit(
+                f"--settings: unknown {name!r}; expected search, ablation, "
+                f"or one of {', '.join(ABLATION)}"
+            )
     done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
     have = set(zip(done.get("setting", []), done.get("seed", []), strict=False))
     for name, items in plan.items():

@@ -287,15 +287,21 @@ class ServoEffect:
     stall_torque_n_m: float = field(
         default=4.0,
         metadata=_p(
-            "N m", 0.5, 6.0, "torque at zero speed (ROBOTIS e-manual: AX-12A 1.5, MX-28 2.5, "
-            "MX-64 6.0 N m; hobby MG996R ~1 N m)"
+            "N m",
+            0.5,
+            6.0,
+            "torque at zero speed (ROBOTIS e-manual: AX-12A 1.5, MX-28 2.5, "
+            "MX-64 6.0 N m; hobby MG996R ~1 N m)",
         ),
     )
     no_load_speed_rad_s: float = field(
         default=6.2,
         metadata=_p(
-            "rad/s", 4.0, 12.0, "joint speed at zero torque (AX-12A 59 rpm = 6.2 rad/s, "
-            "MG996R 0.17 s/60 deg = 6.2 rad/s)"
+            "rad/s",
+            4.0,
+            12.0,
+            "joint speed at zero torque (AX-12A 59 rpm = 6.2 rad/s, "
+            "MG996R 0.17 s/60 deg = 6.2 rad/s)",
         ),
     )
 
@@ -387,6 +393,7 @@ PER_TRIAL_RANDOM_EFFECTS = ("bed_heterogeneity", "bed_packing")
 #: Effects acting between the command and the joint angles: invisible when measured
 #: joint angles are replayed.
 COMMAND_ONLY_EFFECTS = ("servo",)
+
 
 @dataclass
 class SimConfig:

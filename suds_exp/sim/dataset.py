@@ -91,9 +91,7 @@ def plan_trials(
             # a random order, so the longest ones always leave enough cycles outside the
             # shortest (the paper's 48-cycle sweep point, whatever the seed)
             cond = trial_seed(seed, g, f, 0)
-            strata = np.random.default_rng(np.random.SeedSequence(cond + (4,))).permutation(
-                repeats
-            )
+            strata = np.random.default_rng(np.random.SeedSequence(cond + (4,))).permutation(repeats)
             for r in range(1, repeats + 1):
                 ent = trial_seed(seed, g, f, r)
                 rng = np.random.default_rng(np.random.SeedSequence(ent + (0,)))

@@ -252,8 +252,7 @@ def simulate_prescribed(
     if trial_seeds is not None and len(trial_seeds) != n_trials:
         raise ConfigError(f"trial_seeds: got {len(trial_seeds)} seeds for {n_trials} trials")
     beds = [
-        draw_bed(c, None if trial_seeds is None else trial_seeds[k])
-        for k, c in enumerate(configs)
+        draw_bed(c, None if trial_seeds is None else trial_seeds[k]) for k, c in enumerate(configs)
     ]
     bed_modes = np.stack([b[0] for b in beds])
     bed_scale = np.array([b[1] for b in beds])

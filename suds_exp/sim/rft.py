@@ -615,7 +615,8 @@ def run_trials(
     (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, N_PARAMS); bed
     (n_trials, n_modes, 4) random Fourier modes of the bed (kx, ky in 1/mm, phase,
     amplitude; see bed.py) and bed_scale (n_trials,) its trial factor. Outputs (filled):
-    phi_out (n_trials, n_frames, 2) realised joint angles (rad); pose (n_trials, n_frames, 3) world x, y (mm), theta;
+    phi_out (n_trials, n_frames, 2) realised joint angles (rad); pose (n_trials,
+    n_frames, 3) world x, y (mm), theta;
     vel (n_trials, n_frames, 3) body twist vx, vy (mm/s), wz (rad/s), centred on the
     frames; ang_out (n_trials, n_frames, 4); resid (n_trials, n_frames) max scaled
     residual of the solves ending at each frame; iters, n_cont (n_trials,) totals.
