@@ -22,9 +22,9 @@ condition the RMS deviation of r_a, rp_1 and vx from their phase mean (32 phase 
 the condition's trials) as a fraction of their standard deviation (median over
 conditions).
 
-    .venv/bin/python benchmarks/calibrate.py --settings old,nominal --out calib.csv
+    .venv/bin/python benchmarks/calibrate.py --settings old,variability --out calib.csv
     .venv/bin/python benchmarks/calibrate.py --settings search        # the grid
-    .venv/bin/python benchmarks/calibrate.py --settings ablation      # nominal minus one
+    .venv/bin/python benchmarks/calibrate.py --settings ablation      # variability minus one
     .venv/bin/python benchmarks/calibrate.py --set servo.compliance_rad_per_n_m=0.2 ...
 
 A setting is a list of ``EFFECT.PARAM=VALUE`` over the nominal configuration. Rows are
@@ -53,25 +53,26 @@ from suds_exp.preprocess import preprocess  # noqa: E402
 from suds_exp.sim import SimConfig, set_effect, simulate_dataset  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
-#: The variability effects switched off: the simulator before issue 17.
-OLD = [
-    "servo.compliance_rad_per_n_m=0",
-    "bed_heterogeneity.spatial_cv=0",
-    "bed_packing.trial_cv=0",
-    "hinge_friction.torque_n_mm=0",
+#: The variability effects of issue 17 at the values tried first (off in the nominal
+#: robot: they did not make the findings hold, see the README).
+VARIABILITY = [
+    "servo.compliance_rad_per_n_m=0.05",
+    "bed_heterogeneity.spatial_cv=0.2",
+    "bed_packing.trial_cv=0.15",
+    "hinge_friction.torque_n_mm=10",
 ]
 ABLATION = {
-    "nominal": [],
-    "no_servo": [OLD[0]],
-    "no_bed_field": [OLD[1]],
-    "no_packing": [OLD[2]],
-    "no_friction": [OLD[3]],
-    "old": OLD,
+    "old": [],
+    "variability": VARIABILITY,
+    **{
+        f"variability_without_{item.split('.')[0]}": [i for i in VARIABILITY if i != item]
+        for item in VARIABILITY
+    },
 }
 
 
 def search_grid() -> dict[str, list[str]]:
-    """Servo compliance x bed variability (spatial and per-trial, together), friction on."""
+    """Servo compliance x bed variability (spatial and per-trial, together)."""
     grid = {}
     for comp in (0.05, 0.15, 0.3):
         for cv in (0.1, 0.25):
@@ -175,7 +176,7 @@ def summary(table: pd.DataFrame) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--settings", default="old,nominal", help="names, ablation or search")
+    ap.add_argument("--settings", default="old,variability", help="names, ablation or search")
     ap.add_argument("--set", nargs="*", default=None, help="one ad-hoc setting (EFFECT.PARAM=V)")
     ap.add_argument("--gaits", default="S+,O,D-", help="gaits of the reduced design")
     ap.add_argument("--repeats", type=int, default=4)

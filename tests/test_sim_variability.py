@@ -14,6 +14,20 @@ from suds_exp.sim.bed import bed_multiplier, draw_bed
 from suds_exp.sim.gaits import gait_shape
 
 DT = 0.01
+#: The variability of issue 17 switched on (off in the nominal robot).
+VARIABILITY = (
+    "servo.compliance_rad_per_n_m=0.05",
+    "bed_heterogeneity.spatial_cv=0.2",
+    "bed_packing.trial_cv=0.15",
+    "hinge_friction.torque_n_mm=10",
+)
+
+
+def _varied(*more: str) -> SimConfig:
+    cfg = SimConfig()
+    for item in VARIABILITY + more:
+        cfg = set_effect(cfg, item)
+    return cfg
 
 
 def _command(freq: float, seconds: float) -> np.ndarray:
@@ -22,7 +36,7 @@ def _command(freq: float, seconds: float) -> np.ndarray:
 
 
 def test_servo_lags_under_load_more_at_high_frequency():
-    cfg = SimConfig()
+    cfg = _varied()
     lag = {}
     for f in (1 / 3, 1.0):
         cmd = _command(f, 3 / f)
@@ -37,8 +51,8 @@ def test_servo_lags_under_load_more_at_high_frequency():
 
 def test_stiff_servo_and_replay_follow_the_angles_exactly():
     cmd = _command(0.5, 2.0)
-    stiff = set_effect(SimConfig(), "servo=off")
-    for cfg, commanded in ((stiff, True), (SimConfig(), False)):
+    stiff = _varied("servo=off")
+    for cfg, commanded in ((stiff, True), (_varied(), False)):
         out = simulate_prescribed(cmd, DT, cfg, commanded=commanded)
         assert np.array_equal(out["phi"], cmd)
 
@@ -47,14 +61,14 @@ def test_servo_stall_torque_limits_the_stroke():
     cmd = _command(0.5, 4.0)
     strokes = []
     for stall in (1.0, 6.0):
-        cfg = set_effect(SimConfig(), f"servo.stall_torque_n_m={stall}")
+        cfg = _varied(f"servo.stall_torque_n_m={stall}")
         strokes.append(np.ptp(simulate_prescribed(cmd, DT, cfg, commanded=True)["phi"][:, 0]))
     assert strokes[0] < strokes[1] - 0.1
 
 
 def test_bed_field_is_deterministic_per_seed_and_differs_between_seeds():
     cmd = _command(0.5, 4.0)
-    cfg = SimConfig()
+    cfg = _varied()
     a = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(1, 2)])
     b = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(1, 2)])
     c = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(1, 3)])
@@ -65,8 +79,7 @@ def test_bed_field_is_deterministic_per_seed_and_differs_between_seeds():
 
 
 def test_bed_field_has_mean_one_its_cv_and_its_correlation_length():
-    cfg = set_effect(SimConfig(), "bed_heterogeneity.spatial_cv=0.3")
-    cfg = set_effect(cfg, "bed_packing=off")
+    cfg = _varied("bed_heterogeneity.spatial_cv=0.3", "bed_packing=off")
     near, far, values = [], [], []
     rng = np.random.default_rng(0)
     for seed in range(200):
@@ -91,13 +104,13 @@ def test_bed_field_has_mean_one_its_cv_and_its_correlation_length():
 
 def test_hinge_friction_differs_from_flipper_to_flipper():
     cmd = _command(0.5, 4.0)
-    even = set_effect(SimConfig(), "hinge_friction.spread=0")
+    even = _varied("hinge_friction.spread=0")
     base = simulate_prescribed(cmd, DT, even)["flippers"]
     mirror = simulate_prescribed(-cmd, DT, even)["flippers"][:, [1, 0, 3, 2]]
     # equal hinges: the mirrored drive mirrors the flippers
     assert np.abs(base - mirror).max() < 1e-6
-    uneven = simulate_prescribed(cmd, DT, SimConfig())["flippers"]
-    uneven_m = simulate_prescribed(-cmd, DT, SimConfig())["flippers"][:, [1, 0, 3, 2]]
+    uneven = simulate_prescribed(cmd, DT, _varied())["flippers"]
+    uneven_m = simulate_prescribed(-cmd, DT, _varied())["flippers"][:, [1, 0, 3, 2]]
     assert np.abs(uneven - uneven_m).max() > 1e-3
 
 

@@ -271,7 +271,7 @@ class ServoEffect:
     joint angles already contains it."""
 
     compliance_rad_per_n_m: float = field(
-        default=0.05,
+        default=0.0,
         metadata=_p(
             "rad/(N m)",
             0.0,
@@ -315,7 +315,7 @@ class BedHeterogeneityEffect:
     replay of measured joint angles, which cannot know the field, sees the mean bed)."""
 
     spatial_cv: float = field(
-        default=0.2,
+        default=0.0,
         metadata=_p(
             "-",
             0.0,
@@ -340,7 +340,7 @@ class BedPackingEffect:
     factor (rate- and scale-independent RFT); compliant servos and flipper hinges are not."""
 
     trial_cv: float = field(
-        default=0.15,
+        default=0.0,
         metadata=_p(
             "-",
             0.0,
@@ -360,7 +360,7 @@ class HingeFrictionEffect:
     stop leaves it only once the net torque beats its friction (stiction)."""
 
     torque_n_mm: float = field(
-        default=10.0,
+        default=0.0,
         metadata=_p(
             "N mm", 0.0, 60.0, "mean friction torque of a hinge", main=True, on=15.0, off=0.0
         ),
