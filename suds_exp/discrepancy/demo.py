@@ -28,6 +28,7 @@ HIDDEN: dict[str, tuple[dict, str]] = {
     "drag_anisotropy": ({}, "normal_scale"),
     "medium_compaction": ({}, "rate_per_m"),
     "spoke_oscillation": ({}, "gain"),
+    "hinge_friction": ({}, "torque_n_mm"),
 }
 
 

@@ -142,7 +142,8 @@ def connection_command(
 
 
 def effects_table(config_path: Path | None = None, effects: Sequence[str] = ()) -> pd.DataFrame:
-    """One row per effect parameter: effect, state, parameter, unit, nominal, value, range."""
+    """One row per effect parameter: effect, state, parameter, unit, nominal, value, range,
+    meaning (with the source of the range where there is one)."""
     rows = []
     for e in effect_library(build_config(config_path, effects)):
         for p in e["parameters"]:
@@ -156,6 +157,7 @@ def effects_table(config_path: Path | None = None, effects: Sequence[str] = ()) 
                     "nominal": p["nominal"],
                     "value": p["value"],
                     "range": f"{p['range'][0]} .. {p['range'][1]}",
+                    "meaning (source)": p["description"],
                 }
             )
     return pd.DataFrame(rows)

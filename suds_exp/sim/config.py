@@ -261,6 +261,116 @@ class SpokeOscillationEffect:
 
 
 @dataclass
+class ServoEffect:
+    """Compliant position servos (hobby / Dynamixel class): the joint is driven by a
+    proportional controller saturating at the stall torque, minus back-EMF damping
+    (torque = clip(error / compliance, +-stall) - stall / no_load_speed * rate), against
+    the medium's torque on the segment and its flippers. Under load r_a lags and falls
+    short of the command, more in stiffer ground and at higher speed, so r_a carries
+    the force the beans exert. Only the commanded drive feels it: replaying measured
+    joint angles already contains it."""
+
+    compliance_rad_per_n_m: float = field(
+        default=0.0,
+        metadata=_p(
+            "rad/(N m)",
+            0.0,
+            0.5,
+            "joint deflection per unit load torque below stall (1 / proportional gain); "
+            "Dynamixel AX-12A: compliance slope 2-128 steps of 0.29 deg to its 1.5 N m "
+            "stall = 0.007-0.43, default 32 steps = 0.11 (ROBOTIS e-manual)",
+            main=True,
+            on=0.1,
+            off=0.0,
+        ),
+    )
+    stall_torque_n_m: float = field(
+        default=4.0,
+        metadata=_p(
+            "N m",
+            0.5,
+            6.0,
+            "torque at zero speed (ROBOTIS e-manual: AX-12A 1.5, MX-28 2.5, "
+            "MX-64 6.0 N m; hobby MG996R ~1 N m)",
+        ),
+    )
+    no_load_speed_rad_s: float = field(
+        default=6.2,
+        metadata=_p(
+            "rad/s",
+            4.0,
+            12.0,
+            "joint speed at zero torque (AX-12A 59 rpm = 6.2 rad/s, "
+            "MG996R 0.17 s/60 deg = 6.2 rad/s)",
+        ),
+    )
+
+
+@dataclass
+class BedHeterogeneityEffect:
+    """The bed of beans is remixed and levelled by hand between trials, so resistance
+    (packing fraction, immersion depth) varies across the tub: a log-normal random field
+    of mean 1 with Gaussian correlation over `correlation_mm`, multiplying every
+    element's drag where it is. Drawn anew for every trial from the trial's seed (a
+    replay of measured joint angles, which cannot know the field, sees the mean bed)."""
+
+    spatial_cv: float = field(
+        default=0.0,
+        metadata=_p(
+            "-",
+            0.0,
+            0.5,
+            "coefficient of variation of the resistance over the tub",
+            main=True,
+            on=0.2,
+            off=0.0,
+        ),
+    )
+    correlation_mm: float = field(
+        default=300.0,
+        metadata=_p("mm", 100.0, 1000.0, "correlation length of the field (robot: 320 mm)"),
+    )
+
+
+@dataclass
+class BedPackingEffect:
+    """Each remix leaves the whole bed a little looser or denser and the robot a little
+    deeper or shallower: one log-normal resistance factor of mean 1 per trial (drawn from
+    the trial's seed) on every element. Kinematics of a rigid robot are blind to a uniform
+    factor (rate- and scale-independent RFT); compliant servos and flipper hinges are not."""
+
+    trial_cv: float = field(
+        default=0.0,
+        metadata=_p(
+            "-",
+            0.0,
+            0.4,
+            "coefficient of variation of the bed's resistance from trial to trial",
+            main=True,
+            on=0.2,
+            off=0.0,
+        ),
+    )
+
+
+@dataclass
+class HingeFrictionEffect:
+    """Dry (Coulomb) friction in the flippers' tape hinges, different for every flipper:
+    flipper i gets torque x (1 + spread x (+1, -1/3, +1/3, -1)[i]); a flipper resting on a
+    stop leaves it only once the net torque beats its friction (stiction)."""
+
+    torque_n_mm: float = field(
+        default=0.0,
+        metadata=_p(
+            "N mm", 0.0, 60.0, "mean friction torque of a hinge", main=True, on=15.0, off=0.0
+        ),
+    )
+    spread: float = field(
+        default=0.5, metadata=_p("-", 0.0, 1.0, "relative flipper-to-flipper variation")
+    )
+
+
+@dataclass
 class Effects:
     """The named candidate effects; defaults are the nominal configuration."""
 
@@ -271,6 +381,18 @@ class Effects:
     drag_anisotropy: DragAnisotropyEffect = field(default_factory=DragAnisotropyEffect)
     medium_compaction: MediumCompactionEffect = field(default_factory=MediumCompactionEffect)
     spoke_oscillation: SpokeOscillationEffect = field(default_factory=SpokeOscillationEffect)
+    servo: ServoEffect = field(default_factory=ServoEffect)
+    bed_heterogeneity: BedHeterogeneityEffect = field(default_factory=BedHeterogeneityEffect)
+    bed_packing: BedPackingEffect = field(default_factory=BedPackingEffect)
+    hinge_friction: HingeFrictionEffect = field(default_factory=HingeFrictionEffect)
+
+
+#: Effects drawn anew for every trial from its seed: a replay of measured joint angles
+#: cannot reproduce them sample by sample and simulates their mean (a uniform bed).
+PER_TRIAL_RANDOM_EFFECTS = ("bed_heterogeneity", "bed_packing")
+#: Effects acting between the command and the joint angles: invisible when measured
+#: joint angles are replayed.
+COMMAND_ONLY_EFFECTS = ("servo",)
 
 
 @dataclass
@@ -397,3 +519,18 @@ def validate_config(cfg: SimConfig) -> None:
     ):
         if not value > 0:
             raise ConfigError(f"config.effects.{name}: must be > 0, got {value}")
+    _check_ranges(cfg, ("servo", "bed_heterogeneity", "bed_packing", "hinge_friction"))
+
+
+def _check_ranges(cfg: SimConfig, effects: tuple[str, ...]) -> None:
+    """Raise `ConfigError` for a parameter of ``effects`` outside its declared range."""
+    for name in effects:
+        eff = getattr(cfg.effects, name)
+        for f in dataclasses.fields(eff):
+            low, high = f.metadata["range"]
+            value = getattr(eff, f.name)
+            if not low <= value <= high:
+                raise ConfigError(
+                    f"config.effects.{name}.{f.name}: {value} is outside its range "
+                    f"{low}..{high} {f.metadata['unit']}"
+                )

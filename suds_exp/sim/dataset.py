@@ -67,7 +67,12 @@ def plan_trials(
     cycles: tuple[int, int] = (10, 30),
     seed: int = 0,
 ) -> list[TrialSpec]:
-    """Trial specs of a gait x frequency x repeat design (repeats numbered from 1)."""
+    """Trial specs of a gait x frequency x repeat design (repeats numbered from 1).
+
+    A condition's repeats take their cycle counts from equal strata of `cycles` (one
+    each, in an order drawn from the condition's seed): with 4 repeats of 10-30 cycles,
+    the three longer ones hold at least 15 + 20 + 26 cycles.
+    """
     for g in gaits:
         if g not in GAITS:
             raise ConfigError(f"gait {g!r}: expected one of {', '.join(GAITS)}")
@@ -80,17 +85,26 @@ def plan_trials(
     if not 1 <= lo <= hi:
         raise ConfigError(f"cycles {lo}:{hi}: expected 1 <= MIN <= MAX")
     specs = []
+    span = hi - lo + 1
     for g in gaits:
         for f in frequencies_hz:
+            # the repeats of a condition spread over the cycle range, one per stratum in
+            # a random order, so the longest ones always leave enough cycles outside the
+            # shortest (the paper's 48-cycle sweep point, whatever the seed)
+            cond = trial_seed(seed, g, f, 0)
+            strata = np.random.default_rng(np.random.SeedSequence(cond + (4,))).permutation(repeats)
             for r in range(1, repeats + 1):
                 ent = trial_seed(seed, g, f, r)
                 rng = np.random.default_rng(np.random.SeedSequence(ent + (0,)))
+                j = int(strata[r - 1])
+                c_lo = lo + (j * span) // repeats
+                c_hi = max(c_lo, lo + ((j + 1) * span) // repeats - 1)
                 specs.append(
                     TrialSpec(
                         gait=g,
                         frequency_hz=float(f),
                         repeat=r,
-                        n_cycles=int(rng.integers(lo, hi + 1)),
+                        n_cycles=int(rng.integers(c_lo, c_hi + 1)),
                         phase0=float(rng.uniform(0, 2 * math.pi)),
                         pose0=(
                             float(rng.uniform(-300, 300)),
@@ -104,7 +118,9 @@ def plan_trials(
 
 
 def drive(spec: TrialSpec, cfg: SimConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(t (n,) s, commanded phase (n,) rad, realised phi (n, 2) rad) of one trial."""
+    """(t (n,) s, commanded phase (n,) rad, phi (n, 2) rad) of one trial: the joint
+    angles after the actuator's lag and tracking noise, which the `servo` effect (when
+    on) then follows under load."""
     rate = cfg.measurement.sample_rate_hz
     n = int(round(spec.n_cycles / spec.frequency_hz * rate)) + 1
     t = np.arange(n) / rate
@@ -130,7 +146,12 @@ def simulate_trials(
     for k, (_, _, p) in enumerate(drives):
         phi[k, : len(p)] = p
     dt = 1 / cfg.measurement.sample_rate_hz
-    start = dict(pose0=np.array([s.pose0 for s in specs]), n_frames=lengths)
+    start = dict(
+        pose0=np.array([s.pose0 for s in specs]),
+        n_frames=lengths,
+        commanded=True,
+        trial_seeds=[s.seed for s in specs],
+    )
     if changes:
         from suds_exp.sim.schedule import check_times, simulate_scheduled
 
@@ -140,8 +161,9 @@ def simulate_trials(
     else:
         out = simulate_prescribed(phi, dt, cfg, **start)
     truths = []
-    for k, (t, phase, p) in enumerate(drives):
+    for k, (t, phase, _) in enumerate(drives):
         n = len(t)
+        p = out["phi"][k, :n]
         cols = {"t": t, "phase_cmd": phase, "phi1": p[:, 0], "phi2": p[:, 1]}
         for j, c in enumerate(("x", "y", "theta")):
             cols[c] = out["pose"][k, :n, j]

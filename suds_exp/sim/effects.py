@@ -11,7 +11,13 @@ import dataclasses
 import inspect
 
 from suds_exp.errors import ConfigError
-from suds_exp.sim.config import Effects, SimConfig, config_from_dict
+from suds_exp.sim.config import (
+    COMMAND_ONLY_EFFECTS,
+    PER_TRIAL_RANDOM_EFFECTS,
+    Effects,
+    SimConfig,
+    config_from_dict,
+)
 
 EFFECT_NAMES = tuple(f.name for f in dataclasses.fields(Effects))
 
@@ -32,7 +38,9 @@ def effect_library(config: SimConfig | None = None) -> list[dict]:
 
     Keys: ``name``, ``description``, ``main`` (main parameter name), ``on_value``,
     ``off_value``, ``nominal_state`` ("on"/"off", or the mode for ``flippers``),
-    ``state`` (the same for `config`, default nominal) and ``parameters``: list of
+    ``state`` (the same for `config`, default nominal), ``replay`` (what a replay of
+    measured joint angles does with it: "exact", "mean" for an effect drawn anew per
+    trial, "none" for one acting between command and joint) and ``parameters``: list of
     {``name``, ``unit``, ``nominal``, ``value`` (in `config`), ``range`` [low, high],
     ``description``, ``config_key`` (dotted path in the config file)}.
     """
@@ -73,6 +81,11 @@ def effect_library(config: SimConfig | None = None) -> list[dict]:
                 "off_value": off,
                 "nominal_state": state(nominal),
                 "state": state(current),
+                "replay": "mean"
+                if name in PER_TRIAL_RANDOM_EFFECTS
+                else "none"
+                if name in COMMAND_ONLY_EFFECTS
+                else "exact",
                 "parameters": params,
             }
         )

@@ -14,8 +14,11 @@ import numpy as np
 
 from suds_exp.errors import ConfigError
 from suds_exp.sim import rft
+from suds_exp.sim.bed import draw_bed
 from suds_exp.sim.config import SimConfig
 
+#: Relative deviation of flipper_1..flipper_4's hinge friction from the mean, x spread.
+HINGE_FRICTION_PATTERN = (1.0, -1 / 3, 1 / 3, -1.0)
 FLIPPER_MODES = {"free": rft.FL_FREE, "locked": rft.FL_LOCKED, "absent": rft.FL_ABSENT}
 
 
@@ -128,6 +131,15 @@ def pack_params(cfg: SimConfig) -> np.ndarray:
     p[rft.P_SFLOOR] = sv.shape_rate_floor
     p[rft.P_LREF] = L
     p[rft.P_SUBSTEPS] = sv.substeps
+    servo = ef.servo
+    if servo.compliance_rad_per_n_m > 0:
+        stall = servo.stall_torque_n_m * 1000.0 / torque_unit
+        p[rft.P_SGAIN] = 1000.0 / servo.compliance_rad_per_n_m / torque_unit
+        p[rft.P_STALL] = stall
+        p[rft.P_SDAMP] = stall / servo.no_load_speed_rad_s
+    fr = ef.hinge_friction
+    for i, pattern in enumerate(HINGE_FRICTION_PATTERN):
+        p[rft.P_HFRIC + i] = fr.torque_n_mm * (1.0 + fr.spread * pattern) / torque_unit
     return p
 
 
@@ -152,8 +164,10 @@ def simulate_prescribed(
     pose0: np.ndarray | None = None,
     flippers0: np.ndarray | None = None,
     n_frames: np.ndarray | None = None,
+    commanded: bool = False,
+    trial_seeds: list | None = None,
 ) -> dict[str, np.ndarray]:
-    """Simulate a batch of trials driven by prescribed joint angles.
+    """Simulate a batch of trials driven by prescribed joint angles (or servo commands).
 
     Parameters
     ----------
@@ -170,12 +184,19 @@ def simulate_prescribed(
         Initial flipper angles (rad, 0 = closed); default closed.
     n_frames : int array of shape (n_trials,), optional
         Valid frames of each trial when trials of different lengths are padded.
+    commanded : bool
+        False (default): `phi` are the joint angles (e.g. measured), followed exactly.
+        True: `phi` is the servo command; with the `servo` effect on, the joints follow
+        it under the medium's load (returned in ``phi``).
+    trial_seeds : list of n_trials int tuples, optional
+        Entropy of each trial's bed (`bed_heterogeneity`, `bed_packing`); None gives
+        the mean bed (uniform), all a replay of measured angles can know.
 
     Returns
     -------
     dict of arrays (n_trials, n_frames[, k]); frames past a trial's length are NaN:
         ``pose`` (x, y mm, theta rad; world), ``vel`` (vx, vy mm/s, wz rad/s; body frame,
-        centred on each frame), ``flippers`` (4, rad), ``phi`` (2, rad, as given),
+        centred on each frame), ``flippers`` (4, rad), ``phi`` (2, rad, realised joint angles),
         ``residual`` (max scaled force/torque residual of the solves ending at each frame,
         see `residual_units`), ``iterations`` and ``continuations`` (n_trials,).
     """
@@ -207,6 +228,9 @@ def simulate_prescribed(
     )
     if lengths.min(initial=1) < 1 or lengths.max(initial=0) > n_max:
         raise ConfigError("n_frames: each trial needs 1..n_frames samples")
+    if not commanded:
+        # angles are followed exactly, whatever the servo's settings
+        prm[:, rft.P_SGAIN] = 0.0
     for k in range(n_trials):
         if not np.all(np.isfinite(phi[k, : lengths[k]])):
             raise ConfigError(f"phi: trial {k} has non-finite joint angles")
@@ -224,6 +248,14 @@ def simulate_prescribed(
     pose = np.full((n_trials, n_max, 3), np.nan)
     vel = np.full((n_trials, n_max, 3), np.nan)
     ang = np.full((n_trials, n_max, 4), np.nan)
+    phi_real = np.full((n_trials, n_max, 2), np.nan)
+    if trial_seeds is not None and len(trial_seeds) != n_trials:
+        raise ConfigError(f"trial_seeds: got {len(trial_seeds)} seeds for {n_trials} trials")
+    beds = [
+        draw_bed(c, None if trial_seeds is None else trial_seeds[k]) for k, c in enumerate(configs)
+    ]
+    bed_modes = np.stack([b[0] for b in beds])
+    bed_scale = np.array([b[1] for b in beds])
     resid = np.full((n_trials, n_max), np.nan)
     iters = np.zeros(n_trials, dtype=np.int64)
     n_cont = np.zeros(n_trials, dtype=np.int64)
@@ -235,16 +267,17 @@ def simulate_prescribed(
         prm,
         *table.kernel_args(),
         float(dt),
+        bed_modes,
+        bed_scale,
         pose,
         vel,
         ang,
+        phi_real,
         resid,
         iters,
         n_cont,
     )
-    phi_out = phi.copy()
-    for k in range(n_trials):
-        phi_out[k, lengths[k] :] = np.nan
+    phi_out = phi_real
     out = {
         "pose": pose,
         "vel": vel,

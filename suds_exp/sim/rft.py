@@ -36,7 +36,16 @@ P_ASYM, P_NORMAL, P_COMPACT = 6, 7, 8
 P_K, P_PRELOAD, P_AMAX, P_CHINGE = 9, 10, 11, 12
 P_FLMODE, P_FLLOCK, P_TAU = 13, 14, 15
 P_TOL, P_MAXIT, P_SFLOOR, P_LREF, P_SUBSTEPS = 16, 17, 18, 19, 20
-N_PARAMS = 21
+# servo gain (scaled torque per rad, 0 = joints follow the given angles), stall torque
+# (scaled), back-EMF damping (scaled torque s/rad); hinge friction torques of flippers 1-4
+P_SGAIN, P_STALL, P_SDAMP = 21, 22, 23
+P_HFRIC = 24
+N_PARAMS = 28
+# joint rate below which a servo loaded by the beans counts as stuck (rad/s)
+SERVO_STICK_RATE = 0.05
+# time constant (s) over which a servo's load follows the medium's torque
+SERVO_LOAD_TAU = 0.03
+HALF_MID = 0.5
 
 FL_FREE, FL_LOCKED, FL_ABSENT = 0, 1, 2
 N_UNKNOWN = 7
@@ -106,8 +115,10 @@ def _element_geometry(
 
 @njit(cache=True)
 def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, want_j, qh):
-    """Residual R(x) (7,) and, if want_j, Jacobian J (7, 7); qh (4,) gets the hinge
-    generalised torque at the current x (used to release a held hinge)."""
+    """Residual R(x) (7,) and, if want_j, Jacobian J (7, 7); qh (7,) gets the hinge
+    generalised torques at the current x in 0..3 (used to release a held hinge) and the
+    medium's torque about the head and tail joints on the head and tail segments with
+    their flippers in 4, 5 (the load of the servos), counter-clockwise positive."""
     cs = prm[P_CS] * normal_fac
     cf = prm[P_CF]
     cl = prm[P_CL]
@@ -120,7 +131,7 @@ def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R
         if want_j:
             for j in range(N_UNKNOWN):
                 J[i, j] = 0.0
-    for i in range(4):
+    for i in range(6):
         qh[i] = 0.0
     for e in range(el_part.shape[0]):
         w = el_w[e]
@@ -164,6 +175,11 @@ def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R
         R[0] += fx
         R[1] += fy
         R[2] += px * fy - py * fx
+        part = el_part[e]
+        if part == 0 or part == 3 or part == 4:
+            qh[4] += (px - HALF_MID) * fy - py * fx
+        elif part == 2 or part == 5 or part == 6:
+            qh[5] += (px + HALF_MID) * fy - py * fx
         if h >= 0:
             qq = geo[e, 4] * fx + geo[e, 5] * fy
             R[3 + h] += qq
@@ -234,11 +250,15 @@ def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R
                     J[c, j] = 0.0
                 J[c, c] = 1.0
         else:
-            spring = -k * (ang[i] + pre) - c_hinge * x[c]
+            # Coulomb friction, smoothed like the medium's sign functions
+            u = x[c]
+            fr = prm[P_HFRIC + i]
+            ru = math.sqrt(u * u + e2)
+            spring = -k * (ang[i] + pre) - c_hinge * u - fr * u / ru
             R[c] += spring
             qh[i] += spring
             if want_j:
-                J[c, c] += -c_hinge
+                J[c, c] += -c_hinge - fr * e2 / (ru * ru * ru)
 
 
 @njit(cache=True)
@@ -511,9 +531,11 @@ def _solve_with_stops(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge
             at_open = ang[i] >= amax - 1e-9
             if held[i]:
                 # qh = generalised torque on the held hinge; the stop can only push
+                # the hinge's friction holds it on the stop until the torque beats it
+                fr = prm[P_HFRIC + i]
                 if (
-                    (at_closed and qh[i] > 0.0)
-                    or (at_open and qh[i] < 0.0)
+                    (at_closed and qh[i] > fr)
+                    or (at_open and qh[i] < -fr)
                     or not (at_closed or at_open)
                 ):
                     held[i] = False
@@ -527,6 +549,37 @@ def _solve_with_stops(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge
         if not changed:
             break
     return nr, it, cont
+
+
+@njit(cache=True)
+def _servo_rate(err, load, h, p):
+    """Joint rate (rad/s) of a servo with position error ``err`` (rad, command at the
+    step's end minus the joint) against the size ``load`` (scaled) of the medium's
+    torque on the segment over the last steps.
+
+    Solves damp * v = clip(gain * (err - h v), +-stall) + load_v(v), implicit in the
+    error (stable at any gain), where the beans' torque resists the motion like dry
+    friction: load_v = -|load| v / sqrt(v^2 + v0^2) (stuck while the drive is weaker).
+    The left minus right side grows with v, so bisection on [-v_max, v_max] finds it."""
+    gain = p[P_SGAIN]
+    stall = p[P_STALL]
+    damp = p[P_SDAMP]
+    mag = abs(load)
+    vmax = (stall + mag) / damp + 1.0
+    lo, hi = -vmax, vmax
+    for _ in range(48):
+        v = 0.5 * (lo + hi)
+        drive = gain * (err - h * v)
+        if drive > stall:
+            drive = stall
+        elif drive < -stall:
+            drive = -stall
+        f = damp * v + mag * v / math.sqrt(v * v + SERVO_STICK_RATE * SERVO_STICK_RATE) - drive
+        if f > 0.0:
+            hi = v
+        else:
+            lo = v
+    return 0.5 * (lo + hi)
 
 
 @njit(cache=True)
@@ -545,9 +598,12 @@ def run_trials(
     fl_hy,
     fl_side,
     dt,
+    bed,
+    bed_scale,
     pose,
     vel,
     ang_out,
+    phi_out,
     resid,
     iters,
     n_cont,
@@ -555,8 +611,12 @@ def run_trials(
     """Integrate prescribed joint trajectories for a batch of trials.
 
     phi: (n_trials, n_frames, 2) rad, sampled every dt s; n_steps[k] frames used by
-    trial k. pose0 (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials,
-    N_PARAMS). Outputs (filled): pose (n_trials, n_frames, 3) world x, y (mm), theta;
+    trial k: the joint angles, or the servo command when prm[k, P_SGAIN] > 0. pose0
+    (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, N_PARAMS); bed
+    (n_trials, n_modes, 4) random Fourier modes of the bed (kx, ky in 1/mm, phase,
+    amplitude; see bed.py) and bed_scale (n_trials,) its trial factor. Outputs (filled):
+    phi_out (n_trials, n_frames, 2) realised joint angles (rad); pose (n_trials,
+    n_frames, 3) world x, y (mm), theta;
     vel (n_trials, n_frames, 3) body twist vx, vy (mm/s), wz (rad/s), centred on the
     frames; ang_out (n_trials, n_frames, 4); resid (n_trials, n_frames) max scaled
     residual of the solves ending at each frame; iters, n_cont (n_trials,) totals.
@@ -572,6 +632,7 @@ def run_trials(
     amid = np.zeros(4)
     uprev = np.zeros(4)
     w_eff = np.empty(n_el)
+    w_bed = np.empty(n_el)
     for k in range(n_trials):
         p = prm[k]
         lref = p[P_LREF]
@@ -581,6 +642,7 @@ def run_trials(
         tau = p[P_TAU]
         h = dt / nsub
         relax = 1.0 if tau <= 0.0 else 1.0 - math.exp(-h / tau)
+        lp = 1.0 - math.exp(-h / SERVO_LOAD_TAU)
         for e in range(n_el):
             w_eff[e] = el_w[e]
             if el_part[e] >= 3 and mode == FL_ABSENT:
@@ -596,6 +658,16 @@ def run_trials(
         for i in range(N_UNKNOWN):
             x[i] = 0.0
             xlast[i] = 0.0
+        servo = p[P_SGAIN] > 0.0
+        r1, r2 = phi[k, 0, 0], phi[k, 0, 1]
+        load1, load2 = 0.0, 0.0
+        phi_out[k, 0, 0] = r1
+        phi_out[k, 0, 1] = r2
+        n_modes = bed.shape[1]
+        half_var = 0.0
+        for m in range(n_modes):
+            half_var += 0.25 * bed[k, m, 3] * bed[k, m, 3]
+        has_bed = half_var > 0.0 or bed_scale[k] != 1.0
         v_prev0, v_prev1, v_prev2 = 0.0, 0.0, 0.0
         dist = 0.0
         iters[k] = 0
@@ -618,6 +690,12 @@ def run_trials(
                 a2 = phi[k, f, 1] + fa * (phi[k, f + 1, 1] - phi[k, f, 1])
                 b1 = phi[k, f, 0] + fb * (phi[k, f + 1, 0] - phi[k, f, 0])
                 b2 = phi[k, f, 1] + fb * (phi[k, f + 1, 1] - phi[k, f, 1])
+                if servo:
+                    # b = command at the step's end; the joints move from where they are
+                    a1, a2 = r1, r2
+                    b1 = r1 + h * _servo_rate(b1 - r1, load1, h, p)
+                    b2 = r2 + h * _servo_rate(b2 - r2, load2, h, p)
+                    r1, r2 = b1, b2
                 d1 = (b1 - a1) / h
                 d2 = (b2 - a2) / h
                 s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
@@ -642,6 +720,23 @@ def run_trials(
                     fl_side,
                     geo,
                 )
+                if has_bed:
+                    cth = math.cos(TH)
+                    sth = math.sin(TH)
+                    for e in range(n_el):
+                        if w_eff[e] == 0.0:
+                            continue
+                        wx_ = X + lref * (cth * geo[e, 0] - sth * geo[e, 1])
+                        wy_ = Y + lref * (sth * geo[e, 0] + cth * geo[e, 1])
+                        gsum = 0.0
+                        for m in range(n_modes):
+                            gsum += bed[k, m, 3] * math.cos(
+                                bed[k, m, 0] * wx_ + bed[k, m, 1] * wy_ + bed[k, m, 2]
+                            )
+                        w_bed[e] = w_eff[e] * bed_scale[k] * math.exp(gsum - half_var)
+                else:
+                    for e in range(n_el):
+                        w_bed[e] = w_eff[e]
                 # linear predictor of the body twist from the last two solves
                 for i in range(3):
                     xo = x[i]
@@ -650,8 +745,13 @@ def run_trials(
                 normal_fac = p[P_NORMAL] * (1.0 + p[P_COMPACT] * dist)
                 c_hinge = p[P_CHINGE] * s
                 nr, it, cont = _solve_with_stops(
-                    x, geo, w_eff, el_part, p, normal_fac, held, amid, c_hinge, work
+                    x, geo, w_bed, el_part, p, normal_fac, held, amid, c_hinge, work
                 )
+                # the servos feel the medium's torque of this step at the next ones,
+                # low-passed: an unfiltered one-step-late load makes the joint chatter
+                # (the load's size depends on the rates it sets)
+                load1 += lp * (abs(work[4, 4]) - load1)
+                load2 += lp * (abs(work[4, 5]) - load2)
                 iters[k] += it
                 if cont:
                     n_cont[k] += 1
@@ -702,6 +802,8 @@ def run_trials(
                 vel[k, f, 1] = 0.5 * (last1 + m1)
                 vel[k, f, 2] = 0.5 * (last2 + m2)
             last0, last1, last2 = m0, m1, m2
+            phi_out[k, f + 1, 0] = r1 if servo else phi[k, f + 1, 0]
+            phi_out[k, f + 1, 1] = r2 if servo else phi[k, f + 1, 1]
             pose[k, f + 1, 0] = X
             pose[k, f + 1, 1] = Y
             pose[k, f + 1, 2] = TH

@@ -107,12 +107,15 @@ def simulate_scheduled(
     changes: Sequence[Change],
     pose0: np.ndarray,
     n_frames: np.ndarray,
+    **options,
 ) -> dict[str, np.ndarray]:
     """`simulate_prescribed` of a batch with effects changing at the scheduled times.
 
     phi (n_trials, n_max, 2) rad, dt s, pose0 (n_trials, 3), n_frames (n_trials,); every
-    change must come before every trial's last frame (see `check_times`). Returns the
-    arrays of `simulate_prescribed` (pose, vel, flippers, phi, residual per frame).
+    change must come before every trial's last frame (see `check_times`). ``options`` go
+    to every stretch's `simulate_prescribed` (``commanded``, ``trial_seeds``); the servo's
+    internal state restarts at each change. Returns the arrays of `simulate_prescribed`
+    (pose, vel, flippers, phi, residual per frame).
     """
     configs = configs_over_time(config, changes)
     n_trials, n_max = phi.shape[:2]
@@ -122,6 +125,7 @@ def simulate_scheduled(
         "vel": np.full((n_trials, n_max, 3), np.nan),
         "flippers": np.full((n_trials, n_max, 4), np.nan),
         "residual": np.full((n_trials, n_max), np.nan),
+        "phi": np.full((n_trials, n_max, 2), np.nan),
     }
     start_pose = np.asarray(pose0, float)
     start_fl = np.zeros((n_trials, 4))
@@ -131,7 +135,13 @@ def simulate_scheduled(
             continue
         lengths = np.clip(np.asarray(n_frames) - a, 1, b - a + 1)
         piece = simulate_prescribed(
-            phi[:, a : b + 1], dt, cfg, pose0=start_pose, flippers0=start_fl, n_frames=lengths
+            phi[:, a : b + 1],
+            dt,
+            cfg,
+            pose0=start_pose,
+            flippers0=start_fl,
+            n_frames=lengths,
+            **options,
         )
         # frame a was written by the previous stretch; keep it and take a+1.. from this one
         first = 0 if j == 0 else 1
@@ -141,7 +151,4 @@ def simulate_scheduled(
         rows = np.arange(n_trials)
         start_pose = piece["pose"][rows, last]
         start_fl = piece["flippers"][rows, last]
-    out["phi"] = phi.copy()
-    for k in range(n_trials):
-        out["phi"][k, n_frames[k] :] = np.nan
     return out
