@@ -117,7 +117,13 @@ def test_cli_skip_infeasible_and_the_report_names_the_cells(
 ):
     import suds_exp.preprocess as preprocess
 
-    monkeypatch.setattr(preprocess, "load_samples", lambda store, v: samples, raising=False)
+    class Version:  # a preprocessing version named v1 whose samples are `samples`
+        name = "v1"
+
+        def samples(self, trials=None):
+            return samples
+
+    monkeypatch.setattr(preprocess, "get_version", lambda store, ref=None: Version())
     runner = CliRunner()
     base = ["run", "c", "--db", str(db), "--prep", "v1", "--models", "phase-only,TLS"]
     base += ["--boots", "2", "--train-cycles", "2", "--sweep", f"1,{room['best'] + 1}"]

@@ -42,8 +42,8 @@ from scipy.special import logsumexp
 from suds_exp.errors import ConfigError
 from suds_exp.models.agbr import GMR, GMRSuds
 from suds_exp.models.base import (
-    DRA_COLUMNS,
     ModelError,
+    actuated_columns,
     as_array,
     check_choice,
     check_float,
@@ -159,7 +159,8 @@ class _OnlineMixin:
             )
         self.columns_in_, self.columns_out_ = cin, cout
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
-        speed = np.linalg.norm(as_array(samples, DRA_COLUMNS, self.name), axis=1)
+        self.ra_columns_, self.dra_columns_ = actuated_columns(samples)
+        speed = np.linalg.norm(as_array(samples, self.dra_columns_, self.name), axis=1)
         typical = float(np.median(speed)) or float(np.mean(speed)) or 1.0
         self.speed_floor_ = self.speed_floor * typical
         Xin, f = self._inputs(samples)

@@ -29,7 +29,6 @@ campaign stores it so that a resumed campaign compares exactly.
 from __future__ import annotations
 
 import importlib
-import re
 import warnings
 
 import numpy as np
@@ -44,6 +43,7 @@ from suds_exp.models.base import (
     Learner,
     ModelError,
     TimeSeries,
+    actuated_columns,
     as_array,
     check_choice,
     check_float,
@@ -56,7 +56,6 @@ PREFIX = "sklearn:"
 SUDS_SUFFIX = "+SUDS"
 #: Keyword arguments of `make_model` that configure the adapter, not the estimator.
 ADAPTER_PARAMS = ("homogeneous", "speed_floor", "standardize", "mode", "random_state")
-_RA = re.compile(r"^ra_(\d+)$")
 #: Where `sklearn:ClassName` looks for ClassName, in this order.
 _SKLEARN_MODULES = (
     "sklearn.neural_network",
@@ -74,15 +73,6 @@ _SKLEARN_MODULES = (
     "sklearn.dummy",
     "sklearn.isotonic",
 )
-
-
-def actuated_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
-    """(["ra_1".."ra_m"], ["dra_1".."dra_m"]), m the consecutive ra_i columns present."""
-    present = {int(m.group(1)) for c in samples.columns if (m := _RA.match(str(c)))}
-    m = 0
-    while m + 1 in present:
-        m += 1
-    return [f"ra_{i}" for i in range(1, m + 1)], [f"dra_{i}" for i in range(1, m + 1)]
 
 
 def _multi_output(estimator) -> bool:

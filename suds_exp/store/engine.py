@@ -81,11 +81,41 @@ def open_problem(exc: BaseException, path: Path) -> StoreError | None:
     return StoreError(f"{path}: cannot open the database: {text.splitlines()[0]}")
 
 
+#: DuckDB writes its files in whole 4 KiB sectors (3 header sectors, then blocks of
+#: whole sectors), so any other size is a copy cut short.
+SECTOR_BYTES = 4096
+
+
+def check_whole(path: Path) -> None:
+    """Raise the one-line `StoreError` for an existing file that is not a DuckDB database
+    (no ``DUCK`` magic after the header checksum) or whose size is not a whole number of
+    DuckDB sectors: DuckDB itself opens a file cut short and fails only when a query
+    reaches a missing block, possibly after a write began."""
+    try:
+        if not path.is_file():
+            return
+        size = path.stat().st_size
+        with path.open("rb") as f:
+            head = f.read(12)
+    except OSError:
+        return
+    if size == 0:
+        return
+    if head[8:12] != b"DUCK":
+        raise StoreError(f"{path}: not a DuckDB database file")
+    if size % SECTOR_BYTES:
+        raise StoreError(
+            f"{path}: the database file is truncated or damaged ({size} bytes is not a whole "
+            f"number of {SECTOR_BYTES}-byte sectors); restore it from a copy"
+        )
+
+
 def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAIT_S) -> T:
     """Call ``open_fn`` until it stops failing on a file lock, for at most ``wait_s`` s.
 
     A file DuckDB cannot open for another reason (not a database, truncated, a folder
     that cannot be written) raises a one-line `StoreError` naming it."""
+    check_whole(path)
     deadline = time.monotonic() + wait_s
     delay = 0.02
     while True:

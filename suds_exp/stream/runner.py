@@ -95,15 +95,15 @@ def run_stream(
     instead of loading `prep` (tests, benchmarks; `prep` then only labels it).
     on_unit(n_done) is called after each written (learner, trial).
     """
-    from suds_exp.campaign.runner import _resolve_prep
-    from suds_exp.preprocess import load_samples
+    from suds_exp.preprocess import get_version
 
     settings = settings or StreamSettings()
     if settings.warmup_cycles < 1:
         raise StreamError(f"--warmup: {settings.warmup_cycles}; expected >= 1 cycle")
     if samples is None:
-        prep = _resolve_prep(store, prep)
-        samples = load_samples(store, prep, trials)
+        version = get_version(store, prep)
+        prep = version.name
+        samples = version.samples(trials)
     else:
         prep = prep or "(samples given)"
         if trials is not None:
