@@ -30,14 +30,13 @@ from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.pipeline import PrepResult, preprocess
+from suds_exp.preprocess.pipeline import PrepResult, preprocess, write_pca
 from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
     DRP_COLUMNS,
     RP_COLUMNS,
     prep_fits,
-    prep_pca,
     prep_trials,
     prep_versions,
 )
@@ -223,22 +222,7 @@ def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResul
                 ),
             )
         if any(kind == "pca" for kind, *_ in new_fits):
-            cum = np.cumsum(pca.explained_variance_ratio_)
-            store.insert_df(
-                conn,
-                prep_pca.name,
-                pd.DataFrame(
-                    {
-                        "version_id": vid,
-                        "component": np.arange(1, len(cum) + 1),
-                        "explained_variance": pca.explained_variance_,
-                        "explained_variance_ratio": pca.explained_variance_ratio_,
-                        "cumulative_ratio": cum,
-                        "kept": np.arange(len(cum)) < body.chain.modes,
-                        "loadings": [list(r) for r in pca.components_],
-                    }
-                ),
-            )
+            write_pca(store, conn, vid, pca, body.chain.modes)
 
     with progress_bar("Preprocessing", total=len(items), enabled=progress, unit="trials") as adv:
         for tid, rate, frames, t, clean, geom in items:

@@ -454,22 +454,7 @@ def preprocess(
                 ),
             )
         if any(kind == "pca" for kind, *_ in new_fits):
-            cum = np.cumsum(pca.explained_variance_ratio_)
-            store.insert_df(
-                conn,
-                prep_pca.name,
-                pd.DataFrame(
-                    {
-                        "version_id": vid,
-                        "component": np.arange(1, len(cum) + 1),
-                        "explained_variance": pca.explained_variance_,
-                        "explained_variance_ratio": pca.explained_variance_ratio_,
-                        "cumulative_ratio": cum,
-                        "kept": np.arange(len(cum)) < params["k"],
-                        "loadings": [list(r) for r in pca.components_],
-                    }
-                ),
-            )
+            write_pca(store, conn, vid, pca, params["k"])
 
     # pass 2: phase, rates, samples; each batch of trials in one transaction
     with progress_bar(
@@ -518,4 +503,25 @@ def list_versions(store: Store) -> pd.DataFrame:
                v.created_at, v.params
         FROM prep_versions v ORDER BY v.id
         """
+    )
+
+
+def write_pca(store: Store, conn: sa.Connection, version_id: int, pca, n_kept: int) -> None:
+    """Store a fitted PCA's components (``pca``: a fitted scikit-learn PCA) in
+    `prep_pca` for ``version_id``, the first ``n_kept`` marked as kept."""
+    cum = np.cumsum(pca.explained_variance_ratio_)
+    store.insert_df(
+        conn,
+        prep_pca.name,
+        pd.DataFrame(
+            {
+                "version_id": version_id,
+                "component": np.arange(1, len(cum) + 1),
+                "explained_variance": pca.explained_variance_,
+                "explained_variance_ratio": pca.explained_variance_ratio_,
+                "cumulative_ratio": cum,
+                "kept": np.arange(len(cum)) < n_kept,
+                "loadings": [list(r) for r in pca.components_],
+            }
+        ),
     )
