@@ -30,7 +30,7 @@ from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.pipeline import PrepResult, preprocess, write_pca
+from suds_exp.preprocess.pipeline import PrepResult, preprocess, stored_progress, write_pca
 from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
@@ -65,8 +65,9 @@ def preprocess_body(
     if body.is_swimmer():
         return preprocess(store, name, params, trials, progress, preset=preset)
     if preset is not None:
-        raise BodyError(f"{body.source}: preset {preset!r} describes the swimmer; a "
-                        "chain takes --param only")
+        raise BodyError(
+            f"{body.source}: preset {preset!r} describes the swimmer; a chain takes --param only"
+        )
     if body.chain is None:
         raise BodyError(
             f"{body.source}: segment bodies other than the swimmer's (11 roles, motors at "
@@ -121,19 +122,7 @@ def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResul
             meta = meta[meta.id.isin(wanted)]
         if meta.empty:
             raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
-        done: set[int] = set()
-        fits: dict[tuple[str, str], str] = {}
-        if row is not None:
-            done = {
-                int(r[0])
-                for r in conn.execute(
-                    sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == row.id)
-                )
-            }
-            fits = {
-                (r.kind, r.grp): r.state
-                for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == row.id))
-            }
+        done, fits = stored_progress(conn, None if row is None else row.id)
         todo = meta[~meta.id.isin(done)]
         for r in todo.itertuples(index=False):
             check_markers(body, list(r.marker_names), f"trial {r.id} ({r.source_file})")

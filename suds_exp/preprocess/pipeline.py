@@ -349,19 +349,7 @@ def preprocess(
                     "parameters; choose another name"
                 )
         meta = _trial_meta(conn, wanted)
-        done: set[int] = set()
-        fits: dict[tuple[str, str], str] = {}
-        if row is not None:
-            done = {
-                int(r[0])
-                for r in conn.execute(
-                    sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == row.id)
-                )
-            }
-            fits = {
-                (r.kind, r.grp): r.state
-                for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == row.id))
-            }
+        done, fits = stored_progress(conn, None if row is None else row.id)
         todo_meta = meta[~meta.id.isin(done)]
         tracks = _read_tracks(conn, todo_meta) if len(todo_meta) else {}
     skipped = sorted(int(i) for i in meta.id if int(i) in done)
@@ -525,3 +513,23 @@ def write_pca(store: Store, conn: sa.Connection, version_id: int, pca, n_kept: i
             }
         ),
     )
+
+
+def stored_progress(
+    conn: sa.Connection, version_id: int | None
+) -> tuple[set[int], dict[tuple[str, str], str]]:
+    """What version ``version_id`` already holds: the ids of its preprocessed trials and
+    its fitted states by (kind, group); both empty for a version not yet created (None)."""
+    if version_id is None:
+        return set(), {}
+    done = {
+        int(r[0])
+        for r in conn.execute(
+            sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == version_id)
+        )
+    }
+    fits = {
+        (r.kind, r.grp): r.state
+        for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == version_id))
+    }
+    return done, fits
