@@ -19,12 +19,14 @@ after removing one constant offset per trial (the phase zero is a Poincare secti
 the truth's zero). Both estimators use Fourier order 10 and the same Poincare section
 (channel 0 crossing its training mean upwards). Done when ``ratio <= 1.10`` on every case.
 
-The reference below is a port to Python 3 of ``phaser.py`` (2015) of
-https://github.com/sheim/phaser (S. Revzen, S. Wilshin; GPL-3.0; cite Revzen &
-Guckenheimer, Phys. Rev. E 78, 051907, 2008), kept here for this comparison only; the
-library's Phaser is written independently from the paper. The port keeps the reference's
-arithmetic, including its z-scoring by the square root of the standard deviation of the
-second differences and its phasor projection on two principal components.
+The reference is the authors' ``phaser.py`` (2015) of https://github.com/sheim/phaser
+(S. Revzen, S. Wilshin; GPL-3.0; cite Revzen & Guckenheimer, Phys. Rev. E 78, 051907,
+2008). Its code is not part of this project (the library's Phaser is written
+independently from the paper): give ``--reference FILE``, a Python 3 file of yours that
+defines ``ReferencePhaser(records, order, section)`` (records: list of (n_channels,
+n_frames) arrays; section: callable on one frame) returning a callable from a
+(n_channels, n_frames) record to its phase (rad) -- e.g. a Python 3 port of the
+reference's ``Phaser`` class. Without it only our error to the truth is printed.
 """
 
 from __future__ import annotations
@@ -38,7 +40,6 @@ from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.signal import hilbert
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -49,157 +50,18 @@ from suds_exp.store import Store  # noqa: E402
 
 ORDER = 10
 TWO_PI = 2 * np.pi
+#: the user's reference implementation (see --reference), or None
+REFERENCE = None
 
 
-# == port of the reference (sheim/phaser, phaser.py, 2015), benchmark only ================
-class RefFourierSeries:
-    """Port of the reference's ``FourierSeries`` (fit, val, integrate, weighted sum)."""
+def load_reference(path: str):
+    """``ReferencePhaser`` from the Python file ``path``."""
+    import importlib.util
 
-    def fit(self, order, ph, data):
-        phi = np.reshape(np.mod(ph + np.pi, TWO_PI) - np.pi, (1, ph.size))
-        idx = np.argsort(phi).flatten()
-        dat = np.c_[data.take(idx, axis=-1), data[:, idx[0]]]
-        phi = np.concatenate((phi.take(idx), [phi.flat[idx[0]] + TWO_PI]))
-        dphi = np.diff(phi)
-        self.m = np.sum((dat[:, :-1] + dat[:, 1:]) * 0.5 * dphi[None, :], axis=1) / (
-            phi.max() - phi.min()
-        )
-        dat = (dat.T - self.m).T
-        order = int(order)
-        om = np.zeros(2 * order)
-        om[::2] = np.arange(1, order + 1)
-        om[1::2] = -om[::2]
-        self.om = om.reshape(1, 2 * order)
-        zd = (dat[:, 1:] + dat[:, :-1]) / (2.0 * TWO_PI) * dphi
-        th = self.om.T * (phi[1:] - dphi / 2)
-        self.coef = np.exp(-1j * th) @ zd.T
-        return self
-
-    def val(self, phi):
-        phi = np.asarray(phi).reshape(-1, 1)
-        return np.exp(1j * phi * self.om) @ self.coef + self.m
-
-    def integrate(self, z0=0):
-        self.m = np.zeros_like(self.m) + z0
-        self.coef = -1j * self.coef / self.om.T
-        return self
-
-    @staticmethod
-    def big_sum(fts, wgt):
-        out = RefFourierSeries()
-        out.coef = sum(w * f.coef for f, w in zip(fts, wgt, strict=True))
-        out.m = sum(w * f.m for f, w in zip(fts, wgt, strict=True))
-        out.om = fts[0].om
-        return out
-
-
-def _ref_angle_up(zeta):
-    th = np.unwrap(np.angle(zeta))
-    bad = th[:, 0] > th[:, -1]
-    th[bad, :] = -th[bad, :]
-    return th
-
-
-def _ref_slice(x, s):
-    idx = np.flatnonzero((s[1:] > 0) & (s[:-1] <= 0))
-    idx = idx[idx < x.shape[1]]
-    w_before, w_after = np.abs(s[idx])[None, :], np.abs(s[idx + 1])[None, :]
-    return (x[:, idx] * w_after + x[:, idx + 1] * w_before) / (w_before + w_after), idx
-
-
-def _ref_trim_cycle(zeta, y):
-    ph = _ref_angle_up(zeta)
-    n_cyc = np.abs(ph[:, -1] - ph[:, 0]) / TWO_PI
-    cycl = int(np.ceil(zeta.shape[1] / n_cyc.max()))
-    if np.any(n_cyc < 7) or n_cyc.max() - n_cyc.min() > 2:
-        warnings.warn("reference: trial too short or channels disagree; not trimmed", stacklevel=2)
-        return cycl, zeta, y
-    return cycl, zeta[:, cycl:-cycl], y[:, cycl:-cycl]
-
-
-def _ref_series_correction(zetas, order):
-    proto = []
-    for zeta in zetas:
-        theta = _ref_angle_up(zeta)
-        t = np.linspace(0, 1, zeta.shape[1])
-        d_theta, dt = np.diff(theta, 1), np.diff(t)
-        th = (theta[:, 1:] + theta[:, :-1]) / 2.0
-        per = []
-        for ki in range(zeta.shape[0]):
-            row = th[ki].reshape(1, -1)
-            rate = RefFourierSeries().fit(order * 2, row, d_theta[ki].reshape(1, -1) / dt)
-            rate.coef, rate.m = rate.coef / rate.m, np.array([1.0])
-            inv = RefFourierSeries().fit(order, row, 1 / rate.val(row).T)
-            inv.coef, inv.m = inv.coef / inv.m, np.array([1.0])
-            per.append(inv.integrate())
-        proto.append(per)
-    # the reference weighs trials by zeta.shape[0] (the number of channels): equal weights
-    wgt = np.full(len(zetas), 1.0 / len(zetas))
-    return [RefFourierSeries.big_sum([p[ki] for p in proto], wgt) for ki in range(len(proto[0]))]
-
-
-class ReferencePhaser:
-    """Port of the reference's ``Phaser`` (train and eval); data as (n_channels, n_frames)."""
-
-    def __init__(self, trials, order, psecfunc):
-        self.psf = psecfunc
-        y = [np.asarray(t, dtype=float) for t in trials]
-        pooled = np.hstack(y)
-        # ZScore.fromData: "variance" taken as the std of the second differences
-        self.y0 = np.nanmean(pooled, 1)
-        self.S = np.diag(1 / np.sqrt(np.nanstd(np.diff(pooled, n=2, axis=1), axis=1)))
-        zetas, svm, svv = [], [], []
-        for k in range(len(y)):
-            zeta = hilbert(self.zscore(y[k]))
-            _, zeta, y[k] = _ref_trim_cycle(zeta, y[k])
-            sv, idx = _ref_slice(zeta, self.psf(y[k]))
-            if idx.size == 0:
-                raise RuntimeError("reference: Poincare section is empty")
-            zetas.append(zeta)
-            svm.append(np.nanmean(sv, 1))
-            svv.append(np.var(sv, 1) * sv.shape[1] / (sv.shape[1] - 1))
-        svm, svv = np.stack(svm, 1), np.stack(svv, 1)
-        # computeOffset
-        svv = svv / svv.sum(1, keepdims=True)
-        mangle = np.sum(svm * svv, 1)
-        self.mangle = (np.conj(mangle) / np.abs(mangle)).reshape(-1, 1)
-        ofs = np.angle(np.nanmean(self.mangle * svm, 0))
-        zetas = [self.mangle * np.exp(-1j * ofs[k]) * z for k, z in enumerate(zetas)]
-        rho = np.mean([np.nanmean(np.abs(z), 1) for z in zetas], axis=0).reshape(-1, 1)
-        self.P_k = _ref_series_correction(zetas, order)
-        q = []
-        for z in zetas:
-            th = _ref_angle_up(z)
-            p = np.stack([self._corrected(th, ki) for ki in range(th.shape[0])])
-            q.append(np.vstack([np.cos(p) * rho, np.sin(p) * rho]))
-        w = np.hstack(q)
-        w = w - np.nanmean(w, 1)[:, None]
-        pc = np.linalg.svd(w, full_matrices=False)[0]
-        self.prj = (pc[:, 0] + 1j * pc[:, 1]).reshape(-1, 1)
-        self.P = _ref_series_correction([self.prj.T @ qk for qk in q], order)[0]
-
-    def zscore(self, y):
-        return self.S @ (y - self.y0.reshape(-1, 1))
-
-    def _corrected(self, th, ki):
-        p = self.P_k[ki].val(th[ki]).T[0] + th[ki]
-        return p.real  # the series of a real function: imaginary part is rounding
-
-    def __call__(self, dat):
-        p0 = self.psf(dat)
-        zeta = self.mangle * hilbert(self.zscore(dat))
-        z0, _ = _ref_slice(zeta, p0)
-        ofs = np.exp(-1j * np.angle(np.nanmean(z0, axis=1)))
-        th = _ref_angle_up(zeta * ofs[:, None])
-        p = np.stack([self._corrected(th, ki) for ki in range(th.shape[0])])
-        rho = np.nanmean(np.abs(zeta), 1).reshape(-1, 1)
-        ph = _ref_angle_up(self.prj.T @ np.vstack([np.cos(p) * rho, np.sin(p) * rho]))
-        phi = np.real(ph + self.P.val(ph).T)[0]
-        i = np.flatnonzero((p0[1:] > 0) & (p0[:-1] <= 0))
-        at = (p0[i + 1] * np.exp(1j * phi[i + 1]) - p0[i] * np.exp(1j * phi[i])) / (
-            p0[i + 1] - p0[i]
-        )
-        return phi - np.angle(np.sum(at))
+    spec = importlib.util.spec_from_file_location("phaser_reference", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.ReferencePhaser
 
 
 # == cases ===================================================================================
@@ -221,11 +83,13 @@ def compare(train: list[np.ndarray], test: list[np.ndarray], truth: list[np.ndar
     """Both estimators on (n_frames, n_channels) records; errors (rad) and ratio."""
     ours = Phaser(order=ORDER).fit(train)
     mean0 = float(np.concatenate(train)[:, 0].mean())
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ref = ReferencePhaser([x.T for x in train], ORDER, _section(mean0))
     e_ours = phase_error([ours.transform(x) for x in test], truth)
-    e_ref = phase_error([ref(x.T) for x in test], truth)
+    e_ref = float("nan")
+    if REFERENCE is not None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ref = REFERENCE([x.T for x in train], ORDER, _section(mean0))
+        e_ref = phase_error([ref(x.T) for x in test], truth)
     return {
         "channels": train[0].shape[1],
         "ours_rad": e_ours,
@@ -312,7 +176,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--reference", help="Python file defining ReferencePhaser (see above)")
     args = parser.parse_args()
+    global REFERENCE
+    REFERENCE = load_reference(args.reference) if args.reference else None
     cases = {**gait_cases(args.seed), **relaxation_cases(args.seed)}
     if args.json:
         print(json.dumps(cases, indent=1))
@@ -323,6 +190,9 @@ def main() -> None:
             f"{name:<16} {c['ours_rad']:9.4f} {c['reference_rad']:9.4f} {c['ratio']:6.2f}  "
             f"{c['weights']}"
         )
+    if REFERENCE is None:
+        print("no --reference given: the reference columns are NaN")
+        return
     worst = max(c["ratio"] for c in cases.values())
     print(f"worst ratio ours/reference: {worst:.2f} (target <= 1.10)")
 
