@@ -44,18 +44,23 @@ from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 
-def prepare(db: Path, seed: int) -> str:
+def prepare(db: Path, seed: int, effects: list[str] = ()) -> str:
     """Simulate and ingest dataset ``seed`` into ``db`` (unless it holds trials already),
+    with the nominal robot changed by ``effects`` (``EFFECT.PARAM=VALUE`` items),
     preprocess it (idempotent); returns the preprocessing version's name."""
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
-    from suds_exp.sim import simulate_dataset
+    from suds_exp.sim import SimConfig, set_effect, simulate_dataset
+
+    cfg = SimConfig()
+    for item in effects:
+        cfg = set_effect(cfg, item)
 
     store = Store(db)
     store.upgrade()
     if store.query_df("SELECT count(*) AS n FROM trials").n[0] == 0:
         with tempfile.TemporaryDirectory(prefix="suds-findings-") as tmp:
-            data = simulate_dataset(tmp, seed=seed)
+            data = simulate_dataset(tmp, cfg, seed=seed)
             ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=False)
     return preprocess(store, progress=False).name
 
@@ -72,6 +77,12 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--boot", type=int, default=400, help="bootstrap replicates")
     parser.add_argument("--json", action="store_true", help="one JSON document at the end")
+    parser.add_argument(
+        "--set",
+        nargs="*",
+        default=[],
+        help="simulator effects over the nominal robot, EFFECT.PARAM=VALUE (with --seeds)",
+    )
     args = parser.parse_args()
     if (args.db is None) == (args.seeds is None):
         parser.error("give exactly one of --db (read a campaign) or --seeds (simulate and run)")
@@ -87,7 +98,7 @@ def main() -> None:
         store = Store(db)
         if seed is not None:
             t0 = time.perf_counter()
-            prep = prepare(db, seed)
+            prep = prepare(db, seed, args.set)
             t1 = time.perf_counter()
             options = CampaignOptions.parse(
                 prep=prep, boots=args.boots, sweep=args.sweep, train_cycles=30

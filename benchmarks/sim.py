@@ -39,8 +39,10 @@ from suds_exp.sim import (  # noqa: E402
 )
 
 
-def speed(runs: int) -> None:
+def speed(runs: int, effects: list[str] = ()) -> None:
     cfg = SimConfig()
+    for item in effects:
+        cfg = set_effect(cfg, item)
     specs = plan_trials()
     simulate_trials(specs[:1], cfg)  # compile / load the numba cache
     cpu, wall = [], []
@@ -63,7 +65,7 @@ def speed(runs: int) -> None:
     print(f"max force/torque residual of any step: {worst:.2e} (scaled; tol {cfg.solver.tol})")
     with tempfile.TemporaryDirectory() as tmp:
         w0, c0 = time.perf_counter(), time.process_time()
-        ds = simulate_dataset(tmp)
+        ds = simulate_dataset(tmp, cfg)
         c1, w1 = time.process_time(), time.perf_counter()
     print(
         f"simulate_dataset (physics + markers + files): "
@@ -144,8 +146,14 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", type=Path, default=Path("reports/sim-benchmark"))
+    ap.add_argument(
+        "--set", nargs="*", default=[], help="effects over the nominal robot, EFFECT.PARAM=VALUE"
+    )
+    ap.add_argument("--speed-only", action="store_true", help="skip the motion tables")
     args = ap.parse_args()
-    speed(args.runs)
+    speed(args.runs, args.set)
+    if args.speed_only:
+        return
     res = motion_tables()
     print(f"\nwrote {path_figure(res['specs'], res['free'], args.out)}")
 

@@ -720,7 +720,11 @@ def run_trials(
                     fl_side,
                     geo,
                 )
-                if has_bed:
+                if has_bed and half_var == 0.0:
+                    # a uniform bed (packing only): no field to evaluate
+                    for e in range(n_el):
+                        w_bed[e] = w_eff[e] * bed_scale[k]
+                elif has_bed:
                     cth = math.cos(TH)
                     sth = math.sin(TH)
                     for e in range(n_el):
