@@ -74,3 +74,26 @@ def test_a_marker_never_seen_is_refused():
     xyz[:, 0] = np.nan
     with pytest.raises(PreprocessError, match="marker a is never seen"):
         clean_tracks(xyz, marker_names=["a", "b"])
+
+
+def test_two_jumps_a_few_frames_apart_on_a_ringing_spoke_cost_only_their_points(tmp_path):
+    # Found on a simulated trial (D+ at 1 Hz, repeat 2, seed 0, with bed packing and
+    # hinge friction): tail_spoke jumps at frames 1243 and 1256. The two clean runs on
+    # either side were compared over the 15 frames between, as if those frames said
+    # nothing, and the ringing spoke is not linear over 15 frames, so the whole
+    # 1,243-frame run before the jumps was removed and preprocessing refused the trial.
+    from suds_exp.ingest.qtm import read_qtm_tsv
+    from suds_exp.sim import SimConfig, set_effect, simulate_dataset
+
+    cfg = set_effect(SimConfig(), "bed_packing.trial_cv=0.25")
+    cfg = set_effect(cfg, "hinge_friction.torque_n_mm=40")
+    data = simulate_dataset(tmp_path, cfg, gaits=["D+"], frequencies_hz=[1.0], repeats=4)
+    path = data.tsv_paths[1]
+    capture = read_qtm_tsv(path, path.read_text())
+    spoke = capture.marker_names.index("tail_spoke")
+    track = capture.xyz[:, spoke : spoke + 1]
+    steps = np.linalg.norm(np.diff(track[:, 0], axis=0), axis=1)
+    jumps = np.flatnonzero(steps > 9.0)
+    assert jumps.tolist() == [1242, 1243, 1255, 1256]  # the case as found
+    result = clean_tracks(track)
+    assert np.flatnonzero(result.removed[:, 0]).tolist() == [1243, 1256]

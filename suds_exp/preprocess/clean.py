@@ -146,6 +146,13 @@ def _bad_runs(
         """Seen points a < b are consistent with one unbroken track."""
         frames = int(index[b]) - int(index[a])
         off, allowance = miss(np.array([a]), np.array([b]))
+        if b - a > 1:
+            # the points between belong to runs not trusted yet (two jumps a few frames
+            # apart): they say nothing about the path, so the span counts as unseen, as
+            # across a gap; otherwise a long clean run is thrown away because a fast
+            # marker does not move linearly over the up to COMPARE_FRAMES frames between
+            speed = max(np.linalg.norm(velocity[a]), np.linalg.norm(velocity[b]), fast)
+            allowance = np.array([frames * speed])
         return float(off[0]) <= jump_mm + float(allowance[0]) + (frames - 1) * slack
 
     # Longest runs first: a run must continue the nearest trusted run on each side that is
