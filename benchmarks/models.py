@@ -17,7 +17,9 @@ Sections:
 1. fit and predict seconds of every learner (the survey's baselines too) at 30 and 48
    training cycles (~3000 and ~4800 samples), predicting one 20-cycle test trial (2000
    samples); medians over `--repeats` runs, single-threaded BLAS recommended (the
-   campaign runs one job a core).
+   campaign runs one job a core). Wall-clock and CPU seconds of this process: on a
+   shared machine the CPU seconds (single-threaded) do not depend on the others' load.
+   Then each learner's fit+predict CPU seconds against the paper's five together.
 2. Our EM + conditional mean against `gmr.GMM.from_samples` + `GMM.predict` at equal K
    on the same standardised data (GMR without augmentation or branching), with held-out
    RMSE of vx so the speed is compared at comparable accuracy.
@@ -36,11 +38,15 @@ from statistics import median
 import numpy as np
 import pandas as pd
 
+from suds_exp.campaign.definition import SURVEY_LEARNERS
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
 from suds_exp.models.synthetic import make_samples
+from suds_exp.robot import LEARNERS
 
 SAMPLES_PER_CYCLE = 100
+#: The learners `--models survey` adds to the paper's five.
+SURVEY_EXTRA = tuple(n for n in SURVEY_LEARNERS if n not in LEARNERS)
 
 
 def _sim_trials(conditions, n_cycles, repeats, seed):
@@ -142,26 +148,43 @@ def timings(trials, repeats):
         ("KRR", {"random_state": 0}),
     ]
     print("\n## 1. Fit and predict time (s), medians of", repeats, "runs; test trial", len(test))
-    print("| learner | train samples | fit s | predict s | fit+predict s | RMSE vx mm/s |")
-    print("|---|---|---|---|---|---|")
+    print(
+        "| learner | train samples | fit s | predict s | fit+predict s | fit+predict CPU s "
+        "| RMSE vx mm/s |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    cpu = {}
     for n_cycles, tr in train.items():
         for name, params in learners:
-            fits, preds = [], []
+            fits, preds, cpus = [], [], []
             for _ in range(repeats):
                 m = make_model(name, **params)
-                t0 = time.perf_counter()
+                c0, t0 = time.process_time(), time.perf_counter()
                 m.fit(tr)
                 t1 = time.perf_counter()
                 p = m.predict(test)
-                t2 = time.perf_counter()
+                t2, c2 = time.perf_counter(), time.process_time()
                 fits.append(t1 - t0)
                 preds.append(t2 - t1)
+                cpus.append(c2 - c0)
             label = name + (" (rollout)" if params.get("mode") == "rollout" else "")
+            cpu[(label, n_cycles)] = median(cpus)
             print(
                 f"| {label} | {len(tr)} ({n_cycles} cycles) | {median(fits):.4f} | "
                 f"{median(preds):.4f} | {median(fits) + median(preds):.4f} | "
-                f"{_rmse(p, test):.2f} |"
+                f"{median(cpus):.4f} | {_rmse(p, test):.2f} |"
             )
+    five = LEARNERS
+    print("\nfit+predict CPU seconds against the paper's five together (measured mode):")
+    for n_cycles in train:
+        base = sum(cpu[(n, n_cycles)] for n in five)
+        extra = {lab: v for (lab, n), v in cpu.items() if n == n_cycles and lab in SURVEY_EXTRA}
+        parts = ", ".join(f"{lab} {v / base:.2f}" for lab, v in extra.items())
+        total = (base + sum(extra.values())) / base
+        print(
+            f"{n_cycles} cycles: five {base:.3f} s; {parts}; "
+            f"five + survey learners = {total:.2f}x the five (target <= 3x)"
+        )
 
 
 def versus_gmr(trials, repeats, K=12):
