@@ -450,6 +450,8 @@ def survey(
         return
     console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
     console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
+    if "glm" in tables:
+        console.print_frame(tables["glm"].round(3), title="GLM, learner as a factor (100 ln)")
     console.out.print(ratio_sentence(tables["ratio"], cycles))
 
 

@@ -42,10 +42,8 @@ import pandas as pd  # noqa: E402
 from suds_exp.analysis.queries import load_results  # noqa: E402
 from suds_exp.analysis.survey import (  # noqa: E402
     SURVEY_COLUMNS,
-    cycles_to_target,
-    efficiency_ratio,
     ratio_sentence,
-    timing_table,
+    survey_from_results,
 )
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.campaign.definition import LEARNERS  # noqa: E402
@@ -114,16 +112,16 @@ def main() -> None:
     results = pd.concat(
         [load_results(store, n, columns=SURVEY_COLUMNS) for n in names], ignore_index=True
     )
-    t = {
-        "cycles": cycles_to_target(results, 30),
-        "timing": timing_table(results),
-        "ratio": efficiency_ratio(results, "MLP", main_cycles=30, n_boot=args.n_boot),
-    }
+    t = survey_from_results(results, 30, args.n_boot, "MLP")
     print(f"\n{len(results)} results from {len(names)} campaign(s), {args.boots} draws each")
     with pd.option_context("display.width", 200, "display.max_rows", 200):
         print("\nCycles to target (median RMS error of vx, mm/s, same-condition draws):")
         print(t["cycles"].round(2).to_string(index=False))
         print("\n" + ratio_sentence(t["ratio"], 30))
+        if "glm" in t:
+            n = t["glm"].attrs["n_rows"]
+            print(f"\nGLM of 100 ln(RMS error of vx), learner as a factor ({n} rows):")
+            print(t["glm"].round(2).to_string(index=False))
         timing = t["timing"]
         at30 = timing[timing["n_cycles"] == 30].assign(
             total=lambda d: d["fit_seconds"] + d["predict_seconds"]
