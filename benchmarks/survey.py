@@ -24,8 +24,11 @@ and test; default all), and prints
 ``--per-condition`` runs one campaign per condition (``CAMPAIGN-GAIT@FREQ``, train = test
 = that condition), i.e. the sweep's same-condition pairs only, without the main grid's
 cross pairs (which the tables above do not use), and pools their results: the affordable
-way to cover every condition with many draws. ``--skip-infeasible`` leaves out sizes a
-condition's trials cannot supply.
+way to cover every condition with many draws. A campaign decimates its trials to the
+smallest samples per cycle among its own conditions, so the samples are decimated first
+to the whole dataset's (100 per cycle at 1 Hz and 100 Hz capture), as the paper's grid
+over all conditions does. ``--skip-infeasible`` leaves out sizes a condition's trials
+cannot supply.
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from suds_exp.analysis.queries import load_results  # noqa: E402
@@ -74,6 +78,22 @@ def all_conditions(store: Store) -> list[str]:
     return [format_condition((g, f)) for g, f in sorted(t.itertuples(index=False, name=None))]
 
 
+def decimated(store: Store, prep: str) -> pd.DataFrame:
+    """The version's samples, every trial decimated (plain, from its first sample) to the
+    smallest samples per cycle of the whole dataset, as `campaign.bank` does for a grid
+    over every condition."""
+    from suds_exp.preprocess import get_version
+
+    frame = get_version(store, prep).samples().sort_values(["trial_id", "t"])
+    per_trial = frame.groupby("trial_id").agg(
+        dt=("t", lambda t: float(np.median(np.diff(t.to_numpy())))), hz=("frequency_hz", "first")
+    )
+    spc = 1.0 / (per_trial["dt"] * per_trial["hz"])
+    step = (spc / round(float(spc.min()))).round().clip(lower=1).astype(int)
+    index = frame.groupby("trial_id").cumcount().to_numpy()
+    return frame[index % step.reindex(frame["trial_id"]).to_numpy() == 0]
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--db", default="survey.duckdb")
@@ -91,9 +111,11 @@ def main() -> None:
     args = p.parse_args()
     store = Store(args.db)
     ensure_data(store, args.gaits.split(","))
+    samples = None
     if args.per_condition:
         conditions = args.conditions.split(",") if args.conditions else all_conditions(store)
         names = [f"{args.campaign}-{c}" for c in conditions]
+        samples = decimated(store, args.prep)
     else:
         conditions, names = [args.conditions], [args.campaign]
     for name, cond in zip(names, conditions, strict=True):
@@ -107,7 +129,7 @@ def main() -> None:
             test_conditions=cond,
             skip_infeasible=args.skip_infeasible or None,
         )
-        summary = run_campaign(store, name, options, jobs=args.jobs)
+        summary = run_campaign(store, name, options, samples=samples, jobs=args.jobs)
         print(f"{name}: {summary.message()}", flush=True)
     results = pd.concat(
         [load_results(store, n, columns=SURVEY_COLUMNS) for n in names], ignore_index=True
