@@ -27,6 +27,10 @@ Sections:
    (mm/s) over `--boots` random 30-cycle training windows of O at 1/2 Hz, tested on a
    different trial of O at 1/2 Hz (same), O at 1 Hz and O at 1/3 Hz (other speed), and
    D+ at 1/2 Hz (other gait).
+4. Learning curve of the MLP baselines (why their early stopping is what it is): the
+   held-out RMSE of vx (a different 20-cycle trial of O at 1/2 Hz) and the R^2 on a 10 %
+   validation split after 5 ... 200 epochs of Adam on 30 training cycles, for the MLP and
+   MLP+SUDS networks of `sklearn_adapter.BASELINES`, seeds 0 and 1.
 """
 
 from __future__ import annotations
@@ -266,13 +270,43 @@ def ablation(trials, boots, seed):
             print(f"| {name} | {aug} | {br} | {cells} |")
 
 
+def mlp_curve(trials, epochs=(5, 10, 20, 30, 40, 60, 80, 100, 150, 200)):
+    from sklearn.base import clone
+    from sklearn.model_selection import train_test_split
+
+    base = trials[("O", 0.5)]
+    tr, te = _window(base[0], 0, 30), _window(base[2], 0, 20)
+    print("\n## 4. MLP learning curve: held-out RMSE vx mm/s / validation R^2, by epoch")
+    print("| learner | seed | ms/epoch | " + " | ".join(str(e) for e in epochs) + " |")
+    print("|---|---|---|" + "---|" * len(epochs))
+    for name in ("MLP", "MLP+SUDS"):
+        for seed in (0, 1):
+            m = make_model(name, random_state=seed).fit(tr)  # for its scalers and columns
+            X = m.x_scaler_.transform(tr[m.columns_in_].to_numpy()).astype(m.dtype)
+            Y = m.y_scaler_.transform(tr[m.columns_out_].to_numpy()).astype(m.dtype)
+            Xt = m.x_scaler_.transform(te[m.columns_in_].to_numpy()).astype(m.dtype)
+            Xa, Xv, Ya, Yv = train_test_split(X, Y, test_size=0.1, random_state=seed)
+            net = clone(m.estimator).set_params(random_state=seed, early_stopping=False)
+            cells, t0 = [], time.process_time()
+            for epoch in range(1, max(epochs) + 1):
+                net.partial_fit(Xa, Ya)
+                if epoch in epochs:
+                    vx = m.y_scaler_.inverse_transform(net.predict(Xt).astype(float))[:, 0]
+                    rmse = float(np.sqrt(np.mean((vx - te["vx"].to_numpy()) ** 2)))
+                    cells.append(f"{rmse:.2f} / {net.score(Xv, Yv):.4f}")
+            ms = 1000 * (time.process_time() - t0) / max(epochs)
+            print(f"| {name} | {seed} | {ms:.0f} | " + " | ".join(cells) + " |")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--boots", type=int, default=3)
     ap.add_argument("--data", choices=("sim", "synthetic"), default="sim")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation"))
+    ap.add_argument(
+        "--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation", "curve")
+    )
     args = ap.parse_args()
     conditions = [("O", 0.5), ("O", 1.0), ("O", 1 / 3), ("D+", 0.5)]
     t0 = time.perf_counter()
@@ -285,6 +319,8 @@ def main():
         versus_gmr(trials, args.repeats)
     if "ablation" not in args.skip:
         ablation(trials, args.boots, args.seed)
+    if "curve" not in args.skip:
+        mlp_curve(trials)
 
 
 if __name__ == "__main__":

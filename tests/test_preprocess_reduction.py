@@ -97,6 +97,7 @@ def test_reducer_versions_coexist_with_the_pca_version(dataset):  # noqa: F811
         cli("preprocess", "--db", dataset, "--json", "--param", "reduction=autoencoder").stdout
     )
     assert not again["created"] and again["processed"] == []
+    assert len(again["explained_variance_ratio"]) == 1  # the decoder's share, stored
 
 
 def test_bad_reduction_is_one_line_naming_the_parameter_and_changes_nothing(dataset):  # noqa: F811

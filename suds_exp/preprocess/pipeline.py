@@ -472,6 +472,12 @@ def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
         "ORDER BY component",
         [version_id],
     )
+    if frame.empty:  # a kernel-PCA or autoencoder version: its ratio is in its stored state
+        state = store.query_df(
+            "SELECT state FROM prep_fits WHERE version_id = ? AND kind = 'reducer'", [version_id]
+        )
+        if len(state):
+            return json.loads(state.state.iloc[0])["explained_variance_ratio"][:k]
     return frame.explained_variance_ratio.tolist()[:k]
 
 
