@@ -69,13 +69,15 @@ def ensure_data(store: Store, gaits: list[str]) -> None:
         preprocess(store, name="v1", progress=False)
 
 
-def all_conditions(store: Store) -> list[str]:
-    """Every (gait, frequency) of the stored trials as GAIT@FREQ."""
-    from suds_exp.campaign.conditions import format_condition
+def all_conditions(store: Store, spec: str | None = None) -> list[str]:
+    """The stored trials' conditions named by ``spec`` (None: all), as GAIT@FREQ in one
+    spelling (``O@1/3`` and ``O@0.333333`` name the same campaign)."""
+    from suds_exp.campaign.conditions import format_condition, select_conditions
     from suds_exp.ingest import list_trials
 
     t = list_trials(store)[["gait", "frequency_hz"]].drop_duplicates()
-    return [format_condition((g, f)) for g, f in sorted(t.itertuples(index=False, name=None))]
+    have = [(g, round(float(f), 6)) for g, f in t.itertuples(index=False, name=None)]
+    return [format_condition(c) for c in select_conditions(spec, have, "--conditions")]
 
 
 def decimated(store: Store, prep: str) -> pd.DataFrame:
@@ -113,7 +115,7 @@ def main() -> None:
     ensure_data(store, args.gaits.split(","))
     samples = None
     if args.per_condition:
-        conditions = args.conditions.split(",") if args.conditions else all_conditions(store)
+        conditions = all_conditions(store, args.conditions)
         names = [f"{args.campaign}-{c}" for c in conditions]
         samples = decimated(store, args.prep)
     else:
