@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 from sklearn.decomposition import KernelPCA
 
+from suds_exp.preprocess import get_version
 from suds_exp.preprocess.reduction import AutoencoderReducer, KernelPCAReducer
 from suds_exp.preprocess.shape import PassivePCA
+from suds_exp.store import Store
 from tests.conftest import assert_same_db, dump_db
 from tests.test_preprocess_versions import cli, dataset, ingested, sql  # noqa: F401
 
@@ -98,6 +100,10 @@ def test_reducer_versions_coexist_with_the_pca_version(dataset):  # noqa: F811
     )
     assert not again["created"] and again["processed"] == []
     assert len(again["explained_variance_ratio"]) == 1  # the decoder's share, stored
+    # the version's reducer is what library users (e.g. the discrepancy replay) get
+    store = Store(dataset)
+    assert get_version(store, 2).pca.method == "kernel-pca"
+    assert isinstance(get_version(store, 1).pca, PassivePCA)
 
 
 def test_bad_reduction_is_one_line_naming_the_parameter_and_changes_nothing(dataset):  # noqa: F811

@@ -258,10 +258,14 @@ def passive_reducer(
     method = params.get("reduction", "pca")
     kind = fit_kind(method)
     if kind in fits:
-        state = json.loads(fits[kind])
-        if method == "pca":
-            return PassivePCA.from_dict(state), None
-        return _CLASSES[method].from_dict(state), None
+        return reducer_from_state(*kind, fits[kind]), None
     cls = PassivePCA if method == "pca" else _CLASSES[method]
     reducer = cls(params["k"]).fit(passive())
     return reducer, (*kind, json.dumps(reducer.to_dict()))
+
+
+def reducer_from_state(kind: str, group: str, state: str):
+    """The reducer of a `prep_fits` row (kind ``pca``, or ``reducer`` with the method as
+    group) from its JSON state."""
+    d = json.loads(state)
+    return PassivePCA.from_dict(d) if kind == "pca" else _CLASSES[group].from_dict(d)
