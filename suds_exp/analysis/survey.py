@@ -215,14 +215,17 @@ def learner_glm(
     period reference ``>`` (trained slower than tested), gait reference ``near``; a factor
     with one level in the data is left out. Columns: ``model`` (direct / interactions),
     ``term`` (patsy's name), ``coef``, ``ci_low``, ``ci_high`` (response units: ~percent
-    change of the error), ``p_value``; ``attrs["n_rows"]``. A learner coefficient is how
+    change of the error; NaN for a term the data cannot separate from earlier ones),
+    ``p_value``; ``attrs["n_rows"]``. A learner coefficient is how
     much larger (in 100 ln units) its error is than GMR's in the reference category; an
     interaction is how much more (or less) than GMR it loses in that category.
     """
+    import statsmodels.api as sm
     import statsmodels.formula.api as smf
     from threadpoolctl import threadpool_limits
 
     from suds_exp.analysis.glm import REFERENCE as SIMILARITY_REFERENCE
+    from suds_exp.analysis.glm import identifiable_columns
 
     rows = results[results["n_cycles"] == main_cycles]
     frame = pd.DataFrame(
@@ -254,17 +257,29 @@ def learner_glm(
     tables = []
     with threadpool_limits(limits=1, user_api="blas"):
         for label, formula in formulas.items():
-            fit = smf.ols(formula, frame).fit()
-            ci = fit.conf_int(alpha=alpha)
+            design = smf.ols(formula, frame)
+            names = design.exog_names
+            # terms the data cannot tell apart (e.g. same gait = same period when every
+            # condition has one frequency) are NaN, as R's lm reports NA (glm.py does too)
+            keep = identifiable_columns(design.exog)
+            fit = sm.OLS(design.endog, design.exog[:, keep]).fit()
+            coef, low, high, pval = (np.full(len(names), np.nan) for _ in range(4))
+            ci = np.asarray(fit.conf_int(alpha=alpha))
+            coef[keep], low[keep], high[keep], pval[keep] = (
+                fit.params,
+                ci[:, 0],
+                ci[:, 1],
+                fit.pvalues,
+            )
             tables.append(
                 pd.DataFrame(
                     {
                         "model": label,
-                        "term": [_short_term(t) for t in fit.params.index],
-                        "coef": fit.params.to_numpy(),
-                        "ci_low": ci[0].to_numpy(),
-                        "ci_high": ci[1].to_numpy(),
-                        "p_value": fit.pvalues.to_numpy(),
+                        "term": [_short_term(t) for t in names],
+                        "coef": coef,
+                        "ci_low": low,
+                        "ci_high": high,
+                        "p_value": pval,
                     }
                 )
             )
