@@ -16,7 +16,10 @@ and test; default all), and prints
 1. cycles to reach x1.25 of each learner's error at the largest sweep size and to reach
    GMR's 30-cycle error, per learner and test frequency (median RMS error of vx over the
    same-condition draws; `suds_exp.analysis.survey.cycles_to_target`);
-2. the MLP / GMR data ratio with its 95 % paired-bootstrap interval;
+2. the MLP / GMR data ratio with its 95 % paired-bootstrap interval, at GMR's 30-cycle
+   error and at the MLP's own error at each sweep size n (cycles GMR needs to reach the
+   MLP's n-cycle error, against n: `efficiency_ratio` with the roles swapped; a ratio
+   read at GMR's first sweep size is a lower bound);
 3. median fit and predict seconds per learner at 30 cycles, and the survey's learners'
    total against the paper's five (the issue's target: the survey grid no slower than
    3x the five-learner grid).
@@ -46,6 +49,7 @@ import pandas as pd  # noqa: E402
 from suds_exp.analysis.queries import load_results  # noqa: E402
 from suds_exp.analysis.survey import (  # noqa: E402
     SURVEY_COLUMNS,
+    efficiency_ratio,
     ratio_sentence,
     survey_from_results,
 )
@@ -142,6 +146,16 @@ def main() -> None:
         print("\nCycles to target (median RMS error of vx, mm/s, same-condition draws):")
         print(t["cycles"].round(2).to_string(index=False))
         print("\n" + ratio_sentence(t["ratio"], 30))
+        if {"MLP", "GMR"} <= set(results["model"]):
+            print("MLP / GMR data ratio at the MLP's own error after n cycles:")
+            for n in sorted(results["n_cycles"].unique()):
+                x = efficiency_ratio(results, "GMR", "MLP", int(n), n_boot=args.n_boot)
+                lo, hi = (1 / x["high"] if x["high"] > 0 else np.inf), 1 / x["low"]
+                print(
+                    f"  n = {n:>2}: error {x['target']:.2f} mm/s, GMR reaches it at "
+                    f"{x['cycles_model']:.2f} cycles: ratio {1 / x['ratio']:.1f} "
+                    f"(95 % {lo:.1f}-{hi:.1f})"
+                )
         if "glm" in t:
             n = t["glm"].attrs["n_rows"]
             print(f"\nGLM of 100 ln(RMS error of vx), learner as a factor ({n} rows):")
