@@ -150,6 +150,9 @@ def main() -> None:
             print("MLP / GMR data ratio at the MLP's own error after n cycles:")
             for n in sorted(results["n_cycles"].unique()):
                 x = efficiency_ratio(results, "GMR", "MLP", int(n), n_boot=args.n_boot)
+                if not np.isfinite(x["cycles_model"]):
+                    print(f"  n = {n:>2}: error {x['target']:.2f} mm/s, GMR never reaches it")
+                    continue
                 lo, hi = (1 / x["high"] if x["high"] > 0 else np.inf), 1 / x["low"]
                 print(
                     f"  n = {n:>2}: error {x['target']:.2f} mm/s, GMR reaches it at "
@@ -167,6 +170,8 @@ def main() -> None:
         print("\nMedian seconds per job at 30 cycles:")
         print(at30.round(3).to_string(index=False))
         five = at30[at30["model"].isin(LEARNERS)]["total"].sum()
+        if at30["model"].isin(LEARNERS).sum() < len(LEARNERS):
+            return  # not the paper's five: no ratio to them
         print(
             f"\nall {len(at30)} learners / the paper's five, per job: "
             f"{at30['total'].sum() / five:.2f}x (target <= 3x)"
