@@ -337,8 +337,18 @@ def preprocess(
         f"{'created' if result.created else 'reused'}; processed {len(result.processed)} "
         f"trials ({result.n_samples} samples), skipped {len(result.skipped)} already done, "
         f"in {result.seconds:.1f} s; "
-        f"{'shape modes' if 'body' in result.params else 'passive PCs'} explain {ev}"
+        f"{_explained_label(result.params)} explain {ev}"
     )
+
+
+def _explained_label(params: dict) -> str:
+    """What a preprocessing result's explained_variance_ratio describes."""
+    if "body" in params:
+        return "shape modes"
+    return {
+        "kernel-pca": "kernel PCs (feature-space variance)",
+        "autoencoder": "autoencoder coordinates (reconstruction)",
+    }.get(params.get("reduction", "pca"), "passive PCs")
 
 
 @command()
@@ -450,6 +460,8 @@ def survey(
         return
     console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
     console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
+    if "glm" in tables:
+        console.print_frame(tables["glm"].round(3), title="GLM, learner as a factor (100 ln)")
     console.out.print(ratio_sentence(tables["ratio"], cycles))
 
 

@@ -17,7 +17,9 @@ Sections:
 1. fit and predict seconds of every learner (the survey's baselines too) at 30 and 48
    training cycles (~3000 and ~4800 samples), predicting one 20-cycle test trial (2000
    samples); medians over `--repeats` runs, single-threaded BLAS recommended (the
-   campaign runs one job a core).
+   campaign runs one job a core). Wall-clock and CPU seconds of this process: on a
+   shared machine the CPU seconds (single-threaded) do not depend on the others' load.
+   Then each learner's fit+predict CPU seconds against the paper's five together.
 2. Our EM + conditional mean against `gmr.GMM.from_samples` + `GMM.predict` at equal K
    on the same standardised data (GMR without augmentation or branching), with held-out
    RMSE of vx so the speed is compared at comparable accuracy.
@@ -25,6 +27,10 @@ Sections:
    (mm/s) over `--boots` random 30-cycle training windows of O at 1/2 Hz, tested on a
    different trial of O at 1/2 Hz (same), O at 1 Hz and O at 1/3 Hz (other speed), and
    D+ at 1/2 Hz (other gait).
+4. Learning curve of the MLP baselines (why their early stopping is what it is): the
+   held-out RMSE of vx (a different 20-cycle trial of O at 1/2 Hz) and the R^2 on a 10 %
+   validation split after 5 ... 200 epochs of Adam on 30 training cycles, for the MLP and
+   MLP+SUDS networks of `sklearn_adapter.BASELINES`, seeds 0 and 1.
 """
 
 from __future__ import annotations
@@ -36,11 +42,15 @@ from statistics import median
 import numpy as np
 import pandas as pd
 
+from suds_exp.campaign.definition import SURVEY_LEARNERS
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
 from suds_exp.models.synthetic import make_samples
+from suds_exp.robot import LEARNERS
 
 SAMPLES_PER_CYCLE = 100
+#: The learners `--models survey` adds to the paper's five.
+SURVEY_EXTRA = tuple(n for n in SURVEY_LEARNERS if n not in LEARNERS)
 
 
 def _sim_trials(conditions, n_cycles, repeats, seed):
@@ -142,26 +152,43 @@ def timings(trials, repeats):
         ("KRR", {"random_state": 0}),
     ]
     print("\n## 1. Fit and predict time (s), medians of", repeats, "runs; test trial", len(test))
-    print("| learner | train samples | fit s | predict s | fit+predict s | RMSE vx mm/s |")
-    print("|---|---|---|---|---|---|")
+    print(
+        "| learner | train samples | fit s | predict s | fit+predict s | fit+predict CPU s "
+        "| RMSE vx mm/s |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    cpu = {}
     for n_cycles, tr in train.items():
         for name, params in learners:
-            fits, preds = [], []
+            fits, preds, cpus = [], [], []
             for _ in range(repeats):
                 m = make_model(name, **params)
-                t0 = time.perf_counter()
+                c0, t0 = time.process_time(), time.perf_counter()
                 m.fit(tr)
                 t1 = time.perf_counter()
                 p = m.predict(test)
-                t2 = time.perf_counter()
+                t2, c2 = time.perf_counter(), time.process_time()
                 fits.append(t1 - t0)
                 preds.append(t2 - t1)
+                cpus.append(c2 - c0)
             label = name + (" (rollout)" if params.get("mode") == "rollout" else "")
+            cpu[(label, n_cycles)] = median(cpus)
             print(
                 f"| {label} | {len(tr)} ({n_cycles} cycles) | {median(fits):.4f} | "
                 f"{median(preds):.4f} | {median(fits) + median(preds):.4f} | "
-                f"{_rmse(p, test):.2f} |"
+                f"{median(cpus):.4f} | {_rmse(p, test):.2f} |"
             )
+    five = LEARNERS
+    print("\nfit+predict CPU seconds against the paper's five together (measured mode):")
+    for n_cycles in train:
+        base = sum(cpu[(n, n_cycles)] for n in five)
+        extra = {lab: v for (lab, n), v in cpu.items() if n == n_cycles and lab in SURVEY_EXTRA}
+        parts = ", ".join(f"{lab} {v / base:.2f}" for lab, v in extra.items())
+        total = (base + sum(extra.values())) / base
+        print(
+            f"{n_cycles} cycles: five {base:.3f} s; {parts}; "
+            f"five + survey learners = {total:.2f}x the five (target <= 3x)"
+        )
 
 
 def versus_gmr(trials, repeats, K=12):
@@ -243,13 +270,43 @@ def ablation(trials, boots, seed):
             print(f"| {name} | {aug} | {br} | {cells} |")
 
 
+def mlp_curve(trials, epochs=(5, 10, 20, 30, 40, 60, 80, 100, 150, 200)):
+    from sklearn.base import clone
+    from sklearn.model_selection import train_test_split
+
+    base = trials[("O", 0.5)]
+    tr, te = _window(base[0], 0, 30), _window(base[2], 0, 20)
+    print("\n## 4. MLP learning curve: held-out RMSE vx mm/s / validation R^2, by epoch")
+    print("| learner | seed | ms/epoch | " + " | ".join(str(e) for e in epochs) + " |")
+    print("|---|---|---|" + "---|" * len(epochs))
+    for name in ("MLP", "MLP+SUDS"):
+        for seed in (0, 1):
+            m = make_model(name, random_state=seed).fit(tr)  # for its scalers and columns
+            X = m.x_scaler_.transform(tr[m.columns_in_].to_numpy()).astype(m.dtype)
+            Y = m.y_scaler_.transform(tr[m.columns_out_].to_numpy()).astype(m.dtype)
+            Xt = m.x_scaler_.transform(te[m.columns_in_].to_numpy()).astype(m.dtype)
+            Xa, Xv, Ya, Yv = train_test_split(X, Y, test_size=0.1, random_state=seed)
+            net = clone(m.estimator).set_params(random_state=seed, early_stopping=False)
+            cells, t0 = [], time.process_time()
+            for epoch in range(1, max(epochs) + 1):
+                net.partial_fit(Xa, Ya)
+                if epoch in epochs:
+                    vx = m.y_scaler_.inverse_transform(net.predict(Xt).astype(float))[:, 0]
+                    rmse = float(np.sqrt(np.mean((vx - te["vx"].to_numpy()) ** 2)))
+                    cells.append(f"{rmse:.2f} / {net.score(Xv, Yv):.4f}")
+            ms = 1000 * (time.process_time() - t0) / max(epochs)
+            print(f"| {name} | {seed} | {ms:.0f} | " + " | ".join(cells) + " |")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--boots", type=int, default=3)
     ap.add_argument("--data", choices=("sim", "synthetic"), default="sim")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation"))
+    ap.add_argument(
+        "--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation", "curve")
+    )
     args = ap.parse_args()
     conditions = [("O", 0.5), ("O", 1.0), ("O", 1 / 3), ("D+", 0.5)]
     t0 = time.perf_counter()
@@ -262,6 +319,8 @@ def main():
         versus_gmr(trials, args.repeats)
     if "ablation" not in args.skip:
         ablation(trials, args.boots, args.seed)
+    if "curve" not in args.skip:
+        mlp_curve(trials)
 
 
 if __name__ == "__main__":

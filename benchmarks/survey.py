@@ -16,10 +16,22 @@ and test; default all), and prints
 1. cycles to reach x1.25 of each learner's error at the largest sweep size and to reach
    GMR's 30-cycle error, per learner and test frequency (median RMS error of vx over the
    same-condition draws; `suds_exp.analysis.survey.cycles_to_target`);
-2. the MLP / GMR data ratio with its 95 % paired-bootstrap interval;
+2. the MLP / GMR data ratio with its 95 % paired-bootstrap interval, at GMR's 30-cycle
+   error and at the MLP's own error at each sweep size n (cycles GMR needs to reach the
+   MLP's n-cycle error, against n: `efficiency_ratio` with the roles swapped; a ratio
+   read at GMR's first sweep size is a lower bound);
 3. median fit and predict seconds per learner at 30 cycles, and the survey's learners'
    total against the paper's five (the issue's target: the survey grid no slower than
    3x the five-learner grid).
+
+``--per-condition`` runs one campaign per condition (``CAMPAIGN-GAIT@FREQ``, train = test
+= that condition), i.e. the sweep's same-condition pairs only, without the main grid's
+cross pairs (which the tables above do not use), and pools their results: the affordable
+way to cover every condition with many draws. A campaign decimates its trials to the
+smallest samples per cycle among its own conditions, so the samples are decimated first
+to the whole dataset's (100 per cycle at 1 Hz and 100 Hz capture), as the paper's grid
+over all conditions does. ``--skip-infeasible`` leaves out sizes a condition's trials
+cannot supply.
 """
 
 from __future__ import annotations
@@ -31,7 +43,16 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from suds_exp.analysis.survey import ratio_sentence, survey_tables  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from suds_exp.analysis.queries import load_results  # noqa: E402
+from suds_exp.analysis.survey import (  # noqa: E402
+    SURVEY_COLUMNS,
+    efficiency_ratio,
+    ratio_sentence,
+    survey_from_results,
+)
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.campaign.definition import LEARNERS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
@@ -52,6 +73,33 @@ def ensure_data(store: Store, gaits: list[str]) -> None:
         preprocess(store, name="v1", progress=False)
 
 
+def all_conditions(store: Store, spec: str | None = None) -> list[str]:
+    """The stored trials' conditions named by ``spec`` (None: all), as GAIT@FREQ in one
+    spelling (``O@1/3`` and ``O@0.333333`` name the same campaign)."""
+    from suds_exp.campaign.conditions import format_condition, select_conditions
+    from suds_exp.ingest import list_trials
+
+    t = list_trials(store)[["gait", "frequency_hz"]].drop_duplicates()
+    have = [(g, round(float(f), 6)) for g, f in t.itertuples(index=False, name=None)]
+    return [format_condition(c) for c in select_conditions(spec, have, "--conditions")]
+
+
+def decimated(store: Store, prep: str) -> pd.DataFrame:
+    """The version's samples, every trial decimated (plain, from its first sample) to the
+    smallest samples per cycle of the whole dataset, as `campaign.bank` does for a grid
+    over every condition."""
+    from suds_exp.preprocess import get_version
+
+    frame = get_version(store, prep).samples().sort_values(["trial_id", "t"])
+    per_trial = frame.groupby("trial_id").agg(
+        dt=("t", lambda t: float(np.median(np.diff(t.to_numpy())))), hz=("frequency_hz", "first")
+    )
+    spc = 1.0 / (per_trial["dt"] * per_trial["hz"])
+    step = (spc / round(float(spc.min()))).round().clip(lower=1).astype(int)
+    index = frame.groupby("trial_id").cumcount().to_numpy()
+    return frame[index % step.reindex(frame["trial_id"]).to_numpy() == 0]
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--db", default="survey.duckdb")
@@ -63,25 +111,58 @@ def main() -> None:
     p.add_argument("--campaign", default="survey")
     p.add_argument("--models", default="survey")
     p.add_argument("--conditions", default=None)
+    p.add_argument("--per-condition", action="store_true")
+    p.add_argument("--skip-infeasible", action="store_true")
+    p.add_argument("--prep", default="v1")
     args = p.parse_args()
     store = Store(args.db)
     ensure_data(store, args.gaits.split(","))
-    options = CampaignOptions.parse(
-        prep="v1",
-        models=args.models,
-        sweep=args.sweep,
-        boots=args.boots,
-        train_cycles=30,
-        train_conditions=args.conditions,
-        test_conditions=args.conditions,
+    samples = None
+    if args.per_condition:
+        conditions = all_conditions(store, args.conditions)
+        names = [f"{args.campaign}-{c}" for c in conditions]
+        samples = decimated(store, args.prep)
+    else:
+        conditions, names = [args.conditions], [args.campaign]
+    for name, cond in zip(names, conditions, strict=True):
+        options = CampaignOptions.parse(
+            prep=args.prep,
+            models=args.models,
+            sweep=args.sweep,
+            boots=args.boots,
+            train_cycles=30,
+            train_conditions=cond,
+            test_conditions=cond,
+            skip_infeasible=args.skip_infeasible or None,
+        )
+        summary = run_campaign(store, name, options, samples=samples, jobs=args.jobs)
+        print(f"{name}: {summary.message()}", flush=True)
+    results = pd.concat(
+        [load_results(store, n, columns=SURVEY_COLUMNS) for n in names], ignore_index=True
     )
-    summary = run_campaign(store, args.campaign, options, jobs=args.jobs)
-    print(summary.message())
-    t = survey_tables(store, args.campaign, 30, args.n_boot, "MLP")
-    with __import__("pandas").option_context("display.width", 200, "display.max_rows", 200):
+    t = survey_from_results(results, 30, args.n_boot, "MLP")
+    print(f"\n{len(results)} results from {len(names)} campaign(s), {args.boots} draws each")
+    with pd.option_context("display.width", 200, "display.max_rows", 200):
         print("\nCycles to target (median RMS error of vx, mm/s, same-condition draws):")
         print(t["cycles"].round(2).to_string(index=False))
         print("\n" + ratio_sentence(t["ratio"], 30))
+        if {"MLP", "GMR"} <= set(results["model"]):
+            print("MLP / GMR data ratio at the MLP's own error after n cycles:")
+            for n in sorted(results["n_cycles"].unique()):
+                x = efficiency_ratio(results, "GMR", "MLP", int(n), n_boot=args.n_boot)
+                if not np.isfinite(x["cycles_model"]):
+                    print(f"  n = {n:>2}: error {x['target']:.2f} mm/s, GMR never reaches it")
+                    continue
+                lo, hi = (1 / x["high"] if x["high"] > 0 else np.inf), 1 / x["low"]
+                print(
+                    f"  n = {n:>2}: error {x['target']:.2f} mm/s, GMR reaches it at "
+                    f"{x['cycles_model']:.2f} cycles: ratio {1 / x['ratio']:.1f} "
+                    f"(95 % {lo:.1f}-{hi:.1f})"
+                )
+        if "glm" in t:
+            n = t["glm"].attrs["n_rows"]
+            print(f"\nGLM of 100 ln(RMS error of vx), learner as a factor ({n} rows):")
+            print(t["glm"].round(2).to_string(index=False))
         timing = t["timing"]
         at30 = timing[timing["n_cycles"] == 30].assign(
             total=lambda d: d["fit_seconds"] + d["predict_seconds"]
@@ -89,6 +170,8 @@ def main() -> None:
         print("\nMedian seconds per job at 30 cycles:")
         print(at30.round(3).to_string(index=False))
         five = at30[at30["model"].isin(LEARNERS)]["total"].sum()
+        if at30["model"].isin(LEARNERS).sum() < len(LEARNERS):
+            return  # not the paper's five: no ratio to them
         print(
             f"\nall {len(at30)} learners / the paper's five, per job: "
             f"{at30['total'].sum() / five:.2f}x (target <= 3x)"

@@ -336,3 +336,47 @@ def test_the_ratio_interval_widens_with_noisy_draws():
         power_law_results({"GMR": 10.0, "MLP": 12.0}, noise=0.2), "MLP", n_boot=200
     )
     assert r["low"] < r["ratio"] < r["high"]
+
+
+def test_learner_glm_recovers_each_learners_excess_error_and_its_loss_off_gait():
+    from suds_exp.analysis.survey import learner_glm
+
+    # error = base[learner] x 1.5 on a far gait, x 2 more for MLP there; ln-additive exactly
+    base = {"GMR": 2.0, "MLP": 3.0, "kNN": 2.5}
+    rows = []
+    for model, b in base.items():
+        for sim in ("near", "far", "same"):
+            for period in ("<", "=", ">"):
+                for boot in range(2):
+                    e = (
+                        b
+                        * (1.5 if sim == "far" else 1.0)
+                        * (2.0 if sim == "far" and model == "MLP" else 1.0)
+                    )
+                    e *= 1.2 if period == "<" else 1.0
+                    rows.append(
+                        dict(
+                            model=model,
+                            gait_sim=sim,
+                            period_rel=period,
+                            n_cycles=30,
+                            boot=boot,
+                            rmse_vx=e * (1.01 if boot else 1 / 1.01),
+                        )
+                    )
+    t = learner_glm(pd.DataFrame(rows), 30)
+    inter = t[t.model == "interactions"].set_index("term")["coef"]
+    assert inter["learner[MLP]"] == pytest.approx(100 * np.log(1.5), abs=1e-6)
+    assert inter["learner[MLP]:gait_sim[far]"] == pytest.approx(100 * np.log(2.0), abs=1e-6)
+    assert inter["learner[kNN]:gait_sim[far]"] == pytest.approx(0.0, abs=1e-6)
+    direct = t[t.model == "direct"].set_index("term")
+    assert direct.loc["period_rel[<]", "coef"] == pytest.approx(100 * np.log(1.2), abs=1e-6)
+    assert (
+        direct.loc["learner[kNN]", "ci_low"]
+        < 100 * np.log(1.25)
+        < direct.loc["learner[kNN]", "ci_high"]
+    )
+    # one gait similarity and one period (a per-condition sweep) cannot say anything
+    same = pd.DataFrame(rows).query("gait_sim == 'same' and period_rel == '='")
+    with pytest.raises(Exception, match="cross pairs"):
+        learner_glm(same, 30)

@@ -17,9 +17,15 @@ sweep (same-condition pairs at several training sizes):
   size). Above 1: the learner needs that many times GMR's data. A learner that never
   reaches the target within the sweep gives inf.
 - `timing_table`: median fit and predict seconds per learner and training size.
+- `learner_glm`: generalisation across frequency and gait with the learner as a factor:
+  100 ln(RMS error of vx) on learner (reference GMR), period relation and gait
+  similarity (the paper's references), and the learner x similarity interactions, on the
+  main grid's cross pairs (ordinary least squares, as `glm.glm_table`).
 """
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 import pandas as pd
@@ -199,12 +205,103 @@ def timing_table(results: pd.DataFrame) -> pd.DataFrame:
     ).reset_index(drop=True)
 
 
+def learner_glm(
+    results: pd.DataFrame, main_cycles: int = 30, reference: str = REFERENCE, alpha: float = 0.05
+) -> pd.DataFrame:
+    """Coefficients of 100 ln(rmse_vx) ~ learner + period_rel + gait_sim ("direct") and
+    ~ learner x (period_rel + gait_sim) ("interactions") at ``main_cycles``.
+
+    ``results`` are labelled rows (`load_results`). Learner reference ``reference``,
+    period reference ``>`` (trained slower than tested), gait reference ``near``; a factor
+    with one level in the data is left out. Columns: ``model`` (direct / interactions),
+    ``term`` (patsy's name), ``coef``, ``ci_low``, ``ci_high`` (response units: ~percent
+    change of the error; NaN for a term the data cannot separate from earlier ones),
+    ``p_value``; ``attrs["n_rows"]``. A learner coefficient is how
+    much larger (in 100 ln units) its error is than GMR's in the reference category; an
+    interaction is how much more (or less) than GMR it loses in that category.
+    """
+    import statsmodels.api as sm
+    import statsmodels.formula.api as smf
+    from threadpoolctl import threadpool_limits
+
+    from suds_exp.analysis.glm import REFERENCE as SIMILARITY_REFERENCE
+    from suds_exp.analysis.glm import identifiable_columns
+
+    rows = results[results["n_cycles"] == main_cycles]
+    frame = pd.DataFrame(
+        {
+            "y": 100.0 * np.log(rows["rmse_vx"].to_numpy(dtype=float)),
+            "learner": rows["model"].astype(str).to_numpy(),
+            "period_rel": rows["period_rel"].astype(str).to_numpy(),
+            "gait_sim": rows["gait_sim"].astype(str).to_numpy(),
+        }
+    )
+    frame = frame[np.isfinite(frame["y"])]
+    if reference not in set(frame["learner"]):
+        raise AnalysisError(f"survey GLM: no {reference} results at {main_cycles} cycles")
+    terms, similarity = [f"C(learner, Treatment(reference='{reference}'))"], []
+    for name, ref in SIMILARITY_REFERENCE.items():
+        levels = sorted(frame[name].unique())
+        if len(levels) > 1:
+            ref = ref if ref in levels else levels[0]
+            similarity.append(f"C({name}, Treatment(reference='{ref}'))")
+    if not similarity:
+        raise AnalysisError(
+            "survey GLM: the results have one period relation and one gait similarity; "
+            "it needs a main grid with cross pairs (several train and test conditions)"
+        )
+    formulas = {
+        "direct": "y ~ " + " + ".join(terms + similarity),
+        "interactions": f"y ~ {terms[0]} * ({' + '.join(similarity)})",
+    }
+    tables = []
+    with threadpool_limits(limits=1, user_api="blas"):
+        for label, formula in formulas.items():
+            design = smf.ols(formula, frame)
+            names = design.exog_names
+            # terms the data cannot tell apart (e.g. same gait = same period when every
+            # condition has one frequency) are NaN, as R's lm reports NA (glm.py does too)
+            keep = identifiable_columns(design.exog)
+            fit = sm.OLS(design.endog, design.exog[:, keep]).fit()
+            coef, low, high, pval = (np.full(len(names), np.nan) for _ in range(4))
+            ci = np.asarray(fit.conf_int(alpha=alpha))
+            coef[keep], low[keep], high[keep], pval[keep] = (
+                fit.params,
+                ci[:, 0],
+                ci[:, 1],
+                fit.pvalues,
+            )
+            tables.append(
+                pd.DataFrame(
+                    {
+                        "model": label,
+                        "term": [_short_term(t) for t in names],
+                        "coef": coef,
+                        "ci_low": low,
+                        "ci_high": high,
+                        "p_value": pval,
+                    }
+                )
+            )
+    out = pd.concat(tables, ignore_index=True)
+    out.attrs["n_rows"] = len(frame)
+    out.attrs["formulas"] = formulas
+    return out
+
+
+def _short_term(term: str) -> str:
+    """``C(learner, Treatment(reference='GMR'))[T.MLP]`` -> ``learner[MLP]``."""
+    return re.sub(r"C\((\w+), Treatment\(reference='[^']*'\)\)\[T\.([^\]]+)\]", r"\1[\2]", term)
+
+
 SURVEY_COLUMNS = KEY_COLUMNS + (
     "rmse_vx",
     "rmse_vy",
     "rmse_wz",
     "fit_seconds",
     "predict_seconds",
+    "period_rel",
+    "gait_sim",
 )
 
 
@@ -212,15 +309,29 @@ def survey_tables(
     store, campaign: str, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
 ) -> dict:
     """Everything `suds-exp survey` prints: ``cycles`` (`cycles_to_target`), ``timing``
-    (`timing_table`) and ``ratio`` (`efficiency_ratio` of ``model`` against GMR)."""
+    (`timing_table`), ``ratio`` (`efficiency_ratio` of ``model`` against GMR) and, when
+    the campaign has cross pairs, ``glm`` (`learner_glm`)."""
     from suds_exp.analysis.queries import load_results
 
     results = load_results(store, campaign, columns=SURVEY_COLUMNS)
-    return {
+    return survey_from_results(results, main_cycles, n_boot, model)
+
+
+def survey_from_results(
+    results: pd.DataFrame, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
+) -> dict:
+    """`survey_tables` of results already loaded (e.g. several campaigns pooled); ``glm``
+    (`learner_glm`) only when the results hold cross pairs at ``main_cycles``."""
+    out = {
         "cycles": cycles_to_target(results, main_cycles),
         "timing": timing_table(results),
         "ratio": efficiency_ratio(results, model, main_cycles=main_cycles, n_boot=n_boot),
     }
+    try:
+        out["glm"] = learner_glm(results, main_cycles)
+    except AnalysisError:
+        pass  # a sweep without cross pairs: nothing to say about generalisation
+    return out
 
 
 def survey_json(tables: dict) -> dict:

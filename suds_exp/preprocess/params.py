@@ -45,6 +45,9 @@ DEFAULTS: dict[str, Any] = {
     "shape_window_s": 0.21,  # Savitzky-Golay smoothing of r_a and the passive state, s (0 = off)
     "shape_polyorder": 5,  # its polynomial order
     "k": 4,  # number of passive principal components kept as r_p (1..12)
+    # how the 12 passive coordinates become the k of r_p: pca | kernel-pca | autoencoder
+    # (suds_exp.preprocess.reduction)
+    "reduction": "pca",
     # phase (Phaser, Revzen & Guckenheimer 2008)
     "phaser_order": 10,  # order of the Fourier-series corrections
     "phaser_group": "condition",  # trials that share one trained Phaser: condition|gait|trial|all
@@ -70,6 +73,7 @@ SG_KERNELS = ("triweight", "box")
 PHASER_GROUPS = ("condition", "gait", "trial", "all")
 PHASER_CHANNELS = ("ra", "ra+rp")
 RA_REPRS = ("angles", "cartesian")
+REDUCTIONS = ("pca", "kernel-pca", "autoencoder")  # as suds_exp.preprocess.reduction
 
 #: Named parameter sets over `DEFAULTS` (``suds-exp preprocess --preset NAME``).
 #: ``paper``: the paper's own processing ("Data Processing"): jumps over 9 mm removed and
@@ -134,6 +138,7 @@ def _check(params: dict[str, Any]) -> None:
         ("phaser_group", PHASER_GROUPS),
         ("phaser_channels", PHASER_CHANNELS),
         ("ra_repr", RA_REPRS),
+        ("reduction", REDUCTIONS),
     ):
         if params[key] not in choices:
             raise ConfigError(f"--param {key}={params[key]}: expected one of {', '.join(choices)}")

@@ -29,6 +29,7 @@ from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, mea
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
 from suds_exp.preprocess.rates import Differentiator, smooth, window_frames
+from suds_exp.preprocess.reduction import passive_reducer
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
     prep_fits,
@@ -227,7 +228,7 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
     diff = Differentiator.from_params(params)
     w = diff.window(tr.rate_hz, tr.frequency_hz, len(tr.t))
     dra = diff(tr.kin.ra, dt, w)
-    drp = pca.transform_rate(diff(tr.kin.passive, dt, w))
+    drp = pca.transform_rate(diff(tr.kin.passive, dt, w), passive)
     rp = pca.transform(passive)
     vb = diff.body_velocity(tr.kin.xy, tr.kin.heading, dt, w)
     phase = phaser.transform(_phaser_input(tr, pca, params))
@@ -392,13 +393,12 @@ def preprocess(
     for tr in items:
         chain = chain_settings(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
         tr.kin = kinematics(tr.measured, joints[tr.id], chain, params["ra_repr"])
-    if ("pca", "") in fits:
-        pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
-    else:
-        pca = PassivePCA(params["k"]).fit(
-            np.concatenate([_smoothed(tr, params)[1] for tr in items])
-        )
-        new_fits.append(("pca", "", json.dumps(pca.to_dict()), items))
+    # the passive reducer (PCA, kernel PCA or autoencoder: suds_exp.preprocess.reduction)
+    pca, fitted = passive_reducer(
+        params, fits, lambda: np.concatenate([_smoothed(tr, params)[1] for tr in items])
+    )
+    if fitted is not None:
+        new_fits.append((*fitted, items))
     phasers: dict[str, Phaser] = {}
     for group in sorted({tr.group for tr in items}):
         if ("phaser", group) in fits:
@@ -472,6 +472,12 @@ def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
         "ORDER BY component",
         [version_id],
     )
+    if frame.empty:  # a kernel-PCA or autoencoder version: its ratio is in its stored state
+        state = store.query_df(
+            "SELECT state FROM prep_fits WHERE version_id = ? AND kind = 'reducer'", [version_id]
+        )
+        if len(state):
+            return json.loads(state.state.iloc[0])["explained_variance_ratio"][:k]
     return frame.explained_variance_ratio.tolist()[:k]
 
 

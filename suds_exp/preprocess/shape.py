@@ -126,8 +126,9 @@ class PassivePCA:
         """r_p, array of shape (n_samples, k), mm."""
         return (np.asarray(passive) - self.mean_) @ self.components_[: self.n_components].T
 
-    def transform_rate(self, rate: np.ndarray) -> np.ndarray:
-        """dr_p/dt from passive-state rates (n_samples, 12) mm/s -> (n_samples, k) mm/s."""
+    def transform_rate(self, rate: np.ndarray, passive: np.ndarray | None = None) -> np.ndarray:
+        """dr_p/dt from passive-state rates (n_samples, 12) mm/s -> (n_samples, k) mm/s
+        (``passive``, the state, is what nonlinear reducers need; a linear map ignores it)."""
         return np.asarray(rate) @ self.components_[: self.n_components].T
 
     def to_dict(self) -> dict:

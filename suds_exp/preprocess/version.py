@@ -21,6 +21,7 @@ from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.params import actuated_dimension
 from suds_exp.preprocess.phaser import Phaser
 from suds_exp.preprocess.rates import Differentiator
+from suds_exp.preprocess.reduction import reducer_from_state
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import prep_fits, prep_versions
 from suds_exp.robot import sample_columns
@@ -39,7 +40,9 @@ class Version:
     k : int
         Passive principal components kept (r_p has k columns).
     pca : PassivePCA or None
-        The fitted passive-shape PCA (None until a trial has been preprocessed).
+        The fitted passive-shape PCA (None until a trial has been preprocessed); for a
+        version with ``reduction`` kernel-pca or autoencoder, that reducer
+        (`suds_exp.preprocess.reduction`, same transform / transform_rate face).
     phasers : dict of str -> Phaser
         The fitted Phaser of each trial group (``prep_trials.phaser_group``).
     """
@@ -166,13 +169,13 @@ def get_version(store: Store, ref: int | str | None = None) -> Version:
         f = prep_fits.c
         fits = conn.execute(
             sa.select(f.kind, f.grp, f.state)
-            .where(f.version_id == row.id, f.kind.in_(("pca", "phaser")))
+            .where(f.version_id == row.id, f.kind.in_(("pca", "reducer", "phaser")))
             .order_by(f.kind, f.grp)
         ).all()
     pca, phasers = None, {}
     for kind, grp, state in fits:
-        if kind == "pca":
-            pca = PassivePCA.from_dict(json.loads(state))
+        if kind in ("pca", "reducer"):
+            pca = reducer_from_state(kind, grp, state)
         else:
             phasers[grp] = Phaser.from_dict(json.loads(state))
     return Version(
