@@ -7,6 +7,7 @@ Each command parses options and calls one library function; the work lives in
 from __future__ import annotations
 
 import functools
+import re
 from pathlib import Path
 from typing import Annotated
 
@@ -36,16 +37,29 @@ QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress ba
 
 
 #: Library parameters whose flag is not simply ``--`` + the name with dashes.
-FLAGS: dict[str, str] = {}
+FLAGS: dict[str, str] = {
+    "exclude": "--exclude-candidates",
+}
+
+
+def flag(param: str) -> str:
+    """The command-line flag of library parameter ``param`` (``max_effects`` ->
+    ``--max-effects``)."""
+    return FLAGS.get(param, "--" + param.replace("_", "-"))
 
 
 def user_message(exc: SudsError) -> str:
-    """The error's one line in the CLI's words: a leading Python parameter name (the
-    error's ``param``) becomes its flag."""
-    text, param = str(exc), getattr(exc, "param", None)
-    if not param or param.startswith("-") or not text.startswith(param):
+    """The error's one line in the CLI's words: each Python parameter name it is about
+    (the error's ``param``, one name or several) becomes its flag where the text names
+    it as a word."""
+    text, params = str(exc), getattr(exc, "param", None)
+    if not params:
         return text
-    return FLAGS.get(param, "--" + param.replace("_", "-")) + text[len(param) :]
+    for param in (params,) if isinstance(params, str) else params:
+        if param.startswith("-"):
+            continue
+        text = re.sub(rf"(?<![\w.'\"=-]){re.escape(param)}(?![\w'\"-])", flag(param), text)
+    return text
 
 
 def command(*args, **kwargs):
@@ -570,7 +584,7 @@ def discrepancy(
     """
     from suds_exp.discrepancy import DiscrepancyOptions, parse_trial_ids, run_discrepancy
     from suds_exp.discrepancy.discover import DiscoverySettings
-    from suds_exp.discrepancy.workflow import parse_exclude
+    from suds_exp.discrepancy.workflow import default_name, parse_exclude
     from suds_exp.sim.commands import build_config
 
     start = build_config(model, model_effect or [])
@@ -584,6 +598,9 @@ def discrepancy(
         discover=discover,
         discovery=DiscoverySettings(max_terms=max_terms),
     )
+    name = name or default_name()
+    if out is None:
+        out = Path("reports") / (name if name.startswith("discrepancy") else f"discrepancy-{name}")
     result = run_discrepancy(
         open_store(db),
         prep,
@@ -592,7 +609,6 @@ def discrepancy(
         trials=parse_trial_ids(trials),
         options=options,
         out=out,
-        default_out=Path("reports"),
         log=say,
     )
     if json_:

@@ -9,11 +9,12 @@ expected; the CLI prints it and exits with status 2 without a traceback.
 class SudsError(Exception):
     """Base class of every user-facing error in suds-exp.
 
-    ``param`` names the Python parameter the error is about, when the message starts
-    with it; the CLI then shows that parameter's flag instead (``trials`` -> ``--trials``).
+    ``param`` names the Python parameter(s) the error is about (one name or a tuple), as
+    the message writes them; the CLI shows each one's flag instead (``trials`` ->
+    ``--trials``).
     """
 
-    def __init__(self, message: str = "", *, param: str | None = None):
+    def __init__(self, message: str = "", *, param: str | tuple[str, ...] | None = None):
         super().__init__(message)
         self.param = param
 
