@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
-from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.synthetic import synthetic_trial
 
 

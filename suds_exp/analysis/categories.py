@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from suds_exp.analysis.errors import AnalysisError
+from suds_exp.errors import AnalysisError
 from suds_exp.robot import GAITS, LEARNERS
 
 #: The gait axis; gait similarity is the number of steps along it (0 same, 1 near, >1 far).

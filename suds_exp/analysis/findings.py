@@ -35,8 +35,8 @@ import statsmodels.formula.api as smf
 from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import main_cycles
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.analysis.glm import glm_formulas, identifiable_columns
+from suds_exp.errors import AnalysisError
 
 #: Learner names as stored in ``results.model``.
 PHASE, TLS, TLSS, GMR, GMRS = "phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS"

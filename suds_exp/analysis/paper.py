@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import kendalltau
 
-from suds_exp.analysis.errors import AnalysisError
+from suds_exp.errors import AnalysisError
 
 PAPER_FILES = {"glm": "glm_table.csv", "iqr": "iqr_table.csv"}
 

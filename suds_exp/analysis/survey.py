@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.analysis.categories import learner_order
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.campaign.grid import KEY_COLUMNS
+from suds_exp.errors import AnalysisError
 
 REFERENCE = "GMR"
 OWN_FACTOR = 1.25

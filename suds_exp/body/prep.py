@@ -26,8 +26,8 @@ import sqlalchemy as sa
 
 from suds_exp.body.chain_shape import chain_geometry
 from suds_exp.body.description import Body, BodyError, check_markers
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
-from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.params import params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
 from suds_exp.preprocess.pipeline import (

@@ -9,11 +9,11 @@ from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import PAPER_SWEEP, parse_int_list
 from suds_exp.campaign.definition import LEARNERS, CampaignOptions
 from suds_exp.campaign.demo import demo_campaign, demo_options
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import KEY_COLUMNS, Draw, enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, TIMING_COLUMNS
 from suds_exp.campaign.runner import RunSummary, run_campaign
 from suds_exp.campaign.status import campaign_status
+from suds_exp.errors import CampaignError
 
 __all__ = [
     "KEY_COLUMNS",

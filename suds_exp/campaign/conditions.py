@@ -8,8 +8,7 @@ frequency present) or ``@FREQ`` (every gait at that frequency); FREQ may be a fr
 
 from __future__ import annotations
 
-from suds_exp.campaign.errors import CampaignError
-from suds_exp.errors import ConfigError
+from suds_exp.errors import CampaignError, ConfigError
 from suds_exp.robot import GAITS, parse_frequency, parse_ids
 
 Condition = tuple[str, float]

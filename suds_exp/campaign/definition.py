@@ -22,8 +22,8 @@ from suds_exp.campaign.conditions import (
     parse_int_list,
     select_conditions,
 )
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.sampling import infeasible_cells
+from suds_exp.errors import CampaignError
 from suds_exp.robot import LEARNERS
 
 MODES = ("measured", "rollout")

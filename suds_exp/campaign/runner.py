@@ -43,12 +43,11 @@ from suds_exp.campaign.definition import (
     normalise,
     skipped_cells_text,
 )
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
-from suds_exp.errors import StoreError
+from suds_exp.errors import CampaignError, StoreError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 

@@ -20,8 +20,8 @@ import numpy as np
 
 from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import Condition, format_condition
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import Draw
+from suds_exp.errors import CampaignError
 
 
 @dataclass(frozen=True)

@@ -8,8 +8,8 @@ from datetime import UTC, datetime
 import pandas as pd
 
 from suds_exp.campaign.definition import skipped_cells_text
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.lock import run_holder
+from suds_exp.errors import CampaignError
 from suds_exp.store import Store
 
 

@@ -32,9 +32,9 @@ from scipy import stats
 from sklearn.linear_model import orthogonal_mp
 from sklearn.model_selection import GroupKFold
 
-from suds_exp.discrepancy.errors import DiscrepancyError
 from suds_exp.discrepancy.features import PHYSICS, Feature, channel_unit
 from suds_exp.discrepancy.select import trial_losses
+from suds_exp.errors import DiscrepancyError
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,6 @@ import pandas as pd
 
 from suds_exp.discrepancy.discover import Discovery, DiscoverySettings, discover
 from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
-from suds_exp.discrepancy.errors import DiscrepancyError
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
 from suds_exp.discrepancy.replay import (
     ReplaySettings,
@@ -38,6 +37,7 @@ from suds_exp.discrepancy.select import (
     score_candidates,
     trial_losses,
 )
+from suds_exp.errors import DiscrepancyError
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.version import get_version
 from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import median_filter
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 
 #: Steps in the running median that gives a marker's expected motion per frame.
 MEDIAN_STEPS = 7

@@ -20,11 +20,11 @@ import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
+from suds_exp.errors import PreprocessError
 from suds_exp.ingest.layout import trial_layout
 from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
 from suds_exp.preprocess.chain import chain_settings
 from suds_exp.preprocess.clean import CleanResult, clean_tracks
-from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles

@@ -22,16 +22,12 @@ import sqlalchemy as sa
 
 from suds_exp.campaign.definition import differences, resolve_models
 from suds_exp.campaign.lock import RunLock
-from suds_exp.errors import SudsError
+from suds_exp.errors import StreamError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 from suds_exp.stream.prequential import StreamSettings, run_trial, trial_cycles
 
 _SCHEDULE = re.compile(r"schedule=\S+@([0-9.eE+-]+)s")
-
-
-class StreamError(SudsError):
-    """A stream cannot run as asked (bad option, definition differs from the stored one)."""
 
 
 @dataclass
