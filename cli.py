@@ -640,7 +640,7 @@ def demo(
     Simulates the paper's design into a temporary folder, ingests it, preprocesses it,
     runs a small campaign with all five learners and writes its report.
     """
-    from suds_exp.demo import run_demo
+    from suds_exp.testing.demo import run_demo
 
     say = (lambda line: None) if json_ else console.out.print
     summary = run_demo(open_store(db), out, jobs=jobs, progress=not (quiet or json_), say=say)

@@ -18,12 +18,11 @@ from suds_exp.campaign import (
     CampaignError,
     CampaignOptions,
     campaign_status,
-    demo_campaign,
-    demo_options,
     run_campaign,
 )
 from suds_exp.campaign.lock import RunLock
 from suds_exp.store import Store
+from suds_exp.testing.demo_campaign import demo_campaign, demo_options
 from tests.test_campaign_grid import synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS"], boots=2, train_cycles=4, sweep=[1, 2])
@@ -184,7 +183,7 @@ def test_cli_run_and_status(db, samples, monkeypatch):
 def captured(tmp_path_factory) -> Path:
     """A database with preprocessed synthetic captures: 2 gaits x 2 frequencies x 2."""
     from suds_exp.preprocess import preprocess
-    from suds_exp.preprocess.synthetic import write_dataset
+    from suds_exp.testing.synthetic_captures import write_dataset
 
     folder = tmp_path_factory.mktemp("captured")
     manifest = write_dataset(

@@ -16,7 +16,6 @@ from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr,
 from suds_exp.analysis.queries import campaigns, load_results
 from suds_exp.analysis.report import iqr_wide, report_tables, write_report
 from suds_exp.analysis.spread import iqr_table, slope_table
-from suds_exp.analysis.synthetic import synthetic_results
 from suds_exp.errors import AnalysisError
 
 __all__ = [
@@ -40,6 +39,5 @@ __all__ = [
     "paper_table",
     "report_tables",
     "slope_table",
-    "synthetic_results",
     "write_report",
 ]

@@ -60,11 +60,11 @@ def run_demo(
     """
     from suds_exp.analysis import findings, write_report
     from suds_exp.analysis.findings import findings_display, findings_headline, findings_json
-    from suds_exp.campaign.demo import demo_campaign
-    from suds_exp.discrepancy.demo import demo_discrepancy
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
     from suds_exp.sim import simulate_dataset
+    from suds_exp.testing.demo_campaign import demo_campaign
+    from suds_exp.testing.hidden_effects import demo_discrepancy
 
     summary = DemoSummary(campaign=campaign)
     clock = time.perf_counter()
