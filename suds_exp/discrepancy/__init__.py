@@ -4,8 +4,8 @@ closes the held-out gap, add it and repeat."""
 
 from suds_exp.discrepancy.discover import Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, parse_effect_items
+from suds_exp.discrepancy.fit_candidates import FitSettings
 from suds_exp.discrepancy.replay import ReplaySettings
-from suds_exp.discrepancy.select import FitSettings
 from suds_exp.discrepancy.workflow import (
     DiscrepancyOptions,
     DiscrepancyResult,

@@ -33,7 +33,7 @@ from sklearn.linear_model import orthogonal_mp
 from sklearn.model_selection import GroupKFold
 
 from suds_exp.discrepancy.features import PHYSICS, Feature, channel_unit
-from suds_exp.discrepancy.select import trial_losses
+from suds_exp.discrepancy.fit_candidates import trial_losses
 from suds_exp.errors import DiscrepancyError
 
 

@@ -19,6 +19,14 @@ import pandas as pd
 
 from suds_exp.discrepancy.discover import Discovery, DiscoverySettings, discover
 from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
+from suds_exp.discrepancy.fit_candidates import (
+    CandidateResult,
+    FitSettings,
+    fit_candidate,
+    refine_candidate,
+    score_candidates,
+    trial_losses,
+)
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
 from suds_exp.discrepancy.replay import (
     ReplaySettings,
@@ -28,14 +36,6 @@ from suds_exp.discrepancy.replay import (
     replay,
     settings_from_prep,
     window_field,
-)
-from suds_exp.discrepancy.select import (
-    CandidateResult,
-    FitSettings,
-    fit_candidate,
-    refine_candidate,
-    score_candidates,
-    trial_losses,
 )
 from suds_exp.errors import DiscrepancyError
 from suds_exp.preprocess.rates import Differentiator

@@ -23,8 +23,8 @@ Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 from __future__ import annotations
 
 from suds_exp.errors import ConfigError
-from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly

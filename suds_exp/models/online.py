@@ -40,7 +40,6 @@ import pandas as pd
 from scipy.special import logsumexp
 
 from suds_exp.errors import ConfigError
-from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.base import (
     ModelError,
     actuated_columns,
@@ -51,6 +50,7 @@ from suds_exp.models.base import (
     require_columns,
     rollout_bounds,
 )
+from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.mixture import Conditional, fit_mixture, log_gaussians
 
 
