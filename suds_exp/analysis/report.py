@@ -16,11 +16,11 @@ import pandas as pd
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
 from suds_exp.analysis.findings import findings_display, findings_headline, findings_table
+from suds_exp.analysis.formatting import to_html, to_markdown, write_table
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
-from suds_exp.analysis.tables import to_html, to_markdown, write_table
 from suds_exp.errors import AnalysisError
 from suds_exp.store import Store
 
