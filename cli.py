@@ -39,6 +39,11 @@ QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress ba
 #: Library parameters whose flag is not simply ``--`` + the name with dashes.
 FLAGS: dict[str, str] = {
     "exclude": "--exclude-candidates",
+    "effects": "--effect",
+    "model_effects": "--model-effect",
+    "frequencies_hz": "--freqs",
+    "model_params": "--model-param",
+    "params": "--param",
 }
 
 
@@ -218,20 +223,30 @@ def simulate(
     Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on
     """
     from suds_exp.progress import progress_bar
-    from suds_exp.sim.commands import parse_freqs, parse_gaits, simulate_command
+    from suds_exp.sim.commands import (
+        build_config,
+        parse_cycles,
+        parse_freqs,
+        parse_gaits,
+        simulate_command,
+    )
+    from suds_exp.sim.schedule import split_effects
 
-    n = len(parse_gaits(gaits)) * len(parse_freqs(freqs)) * repeats
+    gait_list, freq_list, cycle_range = parse_gaits(gaits), parse_freqs(freqs), parse_cycles(cycles)
+    static, changes = split_effects(effect or [])
+    sim_config = build_config(config, static)
+    n = len(gait_list) * len(freq_list) * repeats
     bar = progress_bar("Simulating", total=n, enabled=not (quiet or json_), unit="trials")
     with bar as advance:
         summary = simulate_command(
             out,
-            config,
-            gaits,
-            freqs,
+            sim_config,
+            gait_list,
+            freq_list,
             repeats,
-            cycles,
+            cycle_range,
             seed,
-            effect or [],
+            changes,
             store=open_store(db) if ingest else None,
             progress=lambda done, total: advance(),
         )
@@ -259,9 +274,9 @@ def connection(
 
     Example: suds-exp connection --out reports/connection.csv --geometry classic
     """
-    from suds_exp.sim.commands import connection_command
+    from suds_exp.sim.commands import build_config, connection_command
 
-    summary = connection_command(out, grid, range_, geometry, config, effect or [])
+    summary = connection_command(out, grid, range_, geometry, build_config(config, effect or []))
     if json_:
         console.print_json(summary)
     else:
@@ -284,7 +299,9 @@ def effects(
     if json_:
         console.print_json(effect_library(build_config(config, effect or [])))
     else:
-        console.print_frame(effects_table(config, effect or []), title="effects (* = main)")
+        console.print_frame(
+            effects_table(build_config(config, effect or [])), title="effects (* = main)"
+        )
 
 
 @command()
@@ -587,7 +604,7 @@ def discrepancy(
     from suds_exp.discrepancy.workflow import default_name, parse_exclude
     from suds_exp.sim.commands import build_config
 
-    start = build_config(model, model_effect or [])
+    start = build_config(model, model_effect or [], param="model_effects")
     say = (lambda line: None) if (quiet or json_) else console.err.print
     # options are checked before the database is opened
     options = DiscrepancyOptions(

@@ -14,10 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from suds_exp.discrepancy.effects import main_parameter, set_effect
+from suds_exp.discrepancy.effects import main_parameter
 from suds_exp.discrepancy.workflow import DiscrepancyOptions, DiscrepancyResult, run_discrepancy
 from suds_exp.robot import FREQUENCIES_HZ
 from suds_exp.sim.config import SimConfig
+from suds_exp.sim.effects import set_effect
 
 #: Hidden-effect settings for the checks: (effect, fixed settings, drawn parameter).
 HIDDEN: dict[str, tuple[dict, str]] = {
