@@ -36,39 +36,39 @@ JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON documen
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 
 
-#: Library parameters whose flag is not simply ``--`` + the name with dashes.
+#: Library parameters whose flag is not simply ``--`` + the name with dashes (in every
+#: command; a command adds its own with ``@command(flags=...)``).
 FLAGS: dict[str, str] = {
-    "exclude": "--exclude-candidates",
     "effects": "--effect",
-    "model_effects": "--model-effect",
-    "frequencies_hz": "--freqs",
-    "model_params": "--model-param",
     "params": "--param",
+    "model_params": "--model-param",
 }
 
 
-def flag(param: str) -> str:
+def flag(param: str, flags: dict[str, str] | None = None) -> str:
     """The command-line flag of library parameter ``param`` (``max_effects`` ->
-    ``--max-effects``)."""
-    return FLAGS.get(param, "--" + param.replace("_", "-"))
+    ``--max-effects``), looked up in ``flags`` and then `FLAGS`."""
+    return {**FLAGS, **(flags or {})}.get(param, "--" + param.replace("_", "-"))
 
 
-def user_message(exc: SudsError) -> str:
+def user_message(exc: SudsError, flags: dict[str, str] | None = None) -> str:
     """The error's one line in the CLI's words: each Python parameter name it is about
-    (the error's ``param``, one name or several) becomes its flag where the text names
-    it as a word."""
+    (the error's ``param``, one name or several) becomes its flag where the text first
+    names it as a word (later uses are ordinary words: "preset papers: unknown preset")."""
     text, params = str(exc), getattr(exc, "param", None)
     if not params:
         return text
     for param in (params,) if isinstance(params, str) else params:
         if param.startswith("-"):
             continue
-        text = re.sub(rf"(?<![\w.'\"=-]){re.escape(param)}(?![\w'\"-])", flag(param), text)
+        word = rf"(?<![\w.'\"=/\\-]){re.escape(param)}(?![\w'\"/\\-])"
+        text = re.sub(word, flag(param, flags), text, count=1)
     return text
 
 
-def command(*args, **kwargs):
-    """`app.command` that turns a `SudsError` into one line on stderr and exit code 2."""
+def command(*args, flags: dict[str, str] | None = None, **kwargs):
+    """`app.command` that turns a `SudsError` into one line on stderr and exit code 2;
+    ``flags`` maps this command's library parameters to flags where `flag` would not."""
 
     def wrap(fn):
         @functools.wraps(fn)
@@ -77,7 +77,7 @@ def command(*args, **kwargs):
                 return fn(*a, **kw)
             except SudsError as exc:
                 console.err.print(
-                    f"[red]error:[/red] {user_message(exc)}", markup=True, highlight=False
+                    f"[red]error:[/red] {user_message(exc, flags)}", markup=True, highlight=False
                 )
                 raise typer.Exit(2) from None
 
@@ -199,7 +199,7 @@ SimConfigOption = Annotated[
 ]
 
 
-@command()
+@command(flags={"frequencies_hz": "--freqs"})
 def simulate(
     out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
     config: SimConfigOption = None,
@@ -260,7 +260,7 @@ def simulate(
         )
 
 
-@command()
+@command(flags={"half_range": "--range"})
 def connection(
     out: Annotated[Path, typer.Option(help="CSV file; figures go beside it (_vx/_vy/_wz.png).")],
     grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,
@@ -501,7 +501,7 @@ def status(
         print_status(report)
 
 
-@command()
+@command(flags={"n_cycles": "--cycles", "paper_dir": "--paper"})
 def report(
     name: Annotated[str, typer.Argument(help="Campaign name.")],
     out: Annotated[Path | None, typer.Option(help="Folder (default: reports/NAME).")] = None,
@@ -531,7 +531,7 @@ def report(
         console.out.print(f"wrote {index}")
 
 
-@command()
+@command(flags={"n_boot": "--boot"})
 def findings(
     name: Annotated[str, typer.Argument(help="Campaign name.")],
     boot: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
@@ -554,7 +554,7 @@ def findings(
         print_findings(table, name)
 
 
-@command()
+@command(flags={"exclude": "--exclude-candidates", "model_effects": "--model-effect"})
 def discrepancy(
     model: Annotated[
         Path | None, typer.Option("--model", help="Starting simulator config (default: nominal).")
@@ -671,7 +671,7 @@ def demo(
 
 
 # -- stream (online learners on a changing robot) ------------------------------------------
-@command()
+@command(flags={"warmup_cycles": "--warmup"})
 def stream(
     name: Annotated[str, typer.Argument(help="Stream name (created, or continued).")],
     models: Annotated[

@@ -47,7 +47,7 @@ def report_tables(
     `iqr_table`.
     """
     if pairs not in PAIRS:
-        raise AnalysisError(f"--pairs {pairs}: expected one of {', '.join(PAIRS)}")
+        raise AnalysisError(f"pairs {pairs}: expected one of {', '.join(PAIRS)}", param="pairs")
     tables: dict[str, pd.DataFrame] = {
         "findings": findings_table(results, n_boot=findings_boot, upper_from=upper_from),
         "categories": category_table(results, n_cycles),
@@ -164,7 +164,9 @@ def write_report(
     """
     if out_dir is None:
         if not _SAFE_NAME.match(campaign):
-            raise AnalysisError(f"campaign {campaign!r} is not a safe folder name; pass --out DIR")
+            raise AnalysisError(
+                f"campaign {campaign!r} is not a safe folder name; pass out DIR", param="out"
+            )
         out_dir = Path("reports") / campaign
     out = Path(out_dir)
     results = load_results(store, campaign)

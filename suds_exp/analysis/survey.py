@@ -41,7 +41,8 @@ def sweep_rows(results: pd.DataFrame) -> pd.DataFrame:
     if rows["n_cycles"].nunique() < 2:
         raise AnalysisError(
             "survey: the campaign has no sample-efficiency sweep (same-condition results "
-            "at two or more training sizes); run it with --sweep, e.g. --sweep 1,2,4,8,16,30,48"
+            "at two or more training sizes); run it with sweep, e.g. sweep 1,2,4,8,16,30,48",
+            param="sweep",
         )
     return rows
 

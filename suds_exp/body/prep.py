@@ -163,7 +163,7 @@ def _clean_chain(body: Body, todo: pd.DataFrame, raw: dict, params: dict) -> lis
         try:
             clean = clean_tracks(xyz, params["jump_mm"], max_gap, body.chain.markers)
         except PreprocessError as exc:
-            raise PreprocessError(f"{label}: {exc}") from None
+            raise PreprocessError(f"{label}: {exc}", param=exc.param) from None
         items.append((int(r.id), rate, frames, t, clean, chain_geometry(clean.xyz, body.chain.up)))
     return items
 

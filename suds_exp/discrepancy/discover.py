@@ -63,7 +63,7 @@ class DiscoverySettings:
 
     def __post_init__(self) -> None:
         if self.max_terms < 1:
-            raise DiscrepancyError(f"--max-terms {self.max_terms}: must be >= 1")
+            raise DiscrepancyError(f"max_terms {self.max_terms}: must be >= 1", param="max_terms")
 
 
 @dataclass

@@ -184,7 +184,7 @@ def _prepare(meta_row, tracks, params: dict) -> _Trial:
         cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in ROLES])
         measured = measure(cleaned.xyz, params["tail_fit"])
     except PreprocessError as exc:
-        raise PreprocessError(f"{label}: {exc}") from None
+        raise PreprocessError(f"{label}: {exc}", param=exc.param) from None
     gait = meta_row.gait if isinstance(meta_row.gait, str) else None
     freq = None if pd.isna(meta_row.frequency_hz) else float(meta_row.frequency_hz)
     group = _group_key(params["phaser_group"], tid, gait, freq)

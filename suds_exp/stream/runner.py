@@ -95,7 +95,9 @@ def run_stream(
 
     settings = settings or StreamSettings()
     if settings.warmup_cycles < 1:
-        raise StreamError(f"--warmup: {settings.warmup_cycles}; expected >= 1 cycle")
+        raise StreamError(
+            f"warmup_cycles: {settings.warmup_cycles}; expected >= 1 cycle", param="warmup_cycles"
+        )
     if samples is None:
         version = get_version(store, prep)
         prep = version.name
@@ -109,8 +111,9 @@ def run_stream(
         missing = sorted(set(int(t) for t in trials) - set(present))
         if missing:
             raise StreamError(
-                f"--trials: no samples of trial(s) {', '.join(map(str, missing))} "
-                f"in preprocessing version {prep}"
+                f"trials: no samples of trial(s) {', '.join(map(str, missing))} "
+                f"in preprocessing version {prep}",
+                param="trials",
             )
     trials = present
     if not trials:
@@ -132,8 +135,9 @@ def run_stream(
         n = len(trial_cycles(g, settings.min_samples))
         if n <= settings.warmup_cycles:
             raise StreamError(
-                f"trial {tid}: {n} whole cycles, not more than --warmup "
-                f"{settings.warmup_cycles}; give longer trials or a shorter warm-up"
+                f"trial {tid}: {n} whole cycles, not more than warmup_cycles "
+                f"{settings.warmup_cycles}; give longer trials or a shorter warm-up",
+                param="warmup_cycles",
             )
     definition = _definition(models, trials, prep, settings, changes)
     summary = StreamSummary(name, len(definition["models"]) * len(trials), 0, trials=trials)

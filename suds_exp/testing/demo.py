@@ -91,7 +91,7 @@ def run_demo(
             # same conditions: never overwrite it, say how to run the demo anyway.
             raise IngestError(
                 f"{exc} -- the demo's simulated trials clash with trials already in "
-                f"{store.path}; run the demo on its own database: suds-exp demo --db demo.duckdb"
+                f"{store.path}; run the demo on a database of its own, e.g. demo.duckdb"
             ) from None
         summary.n_trials = len(results)
         fresh = sum(r.status == "ingested" for r in results)
