@@ -605,7 +605,6 @@ def discrepancy(
     from suds_exp.sim.commands import build_config
 
     start = build_config(model, model_effect or [], param="model_effects")
-    say = (lambda line: None) if (quiet or json_) else console.err.print
     # options are checked before the database is opened
     options = DiscrepancyOptions(
         alpha=alpha,
@@ -626,7 +625,7 @@ def discrepancy(
         trials=parse_trial_ids(trials),
         options=options,
         out=out,
-        log=say,
+        progress=not (quiet or json_),
     )
     if json_:
         console.print_json(result.to_json())

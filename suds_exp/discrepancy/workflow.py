@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -40,6 +40,7 @@ from suds_exp.discrepancy.replay import (
 from suds_exp.errors import DiscrepancyError
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.version import get_version
+from suds_exp.progress import progress_lines
 from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 from suds_exp.sim.config import SimConfig
 
@@ -658,7 +659,7 @@ def run_discrepancy(
     options: DiscrepancyOptions | None = None,
     out: str | Path | None = None,
     samples: pd.DataFrame | None = None,
-    log: Callable[[str], None] | None = None,
+    progress: bool = False,
 ) -> DiscrepancyResult:
     """Find, name and fix what ``model`` misses about the measured trials.
 
@@ -681,8 +682,8 @@ def run_discrepancy(
     samples : DataFrame, optional
         A samples frame to use instead of loading one from the store; its rates are
         taken to come from the default preprocessing parameters' differentiator.
-    log : callable, optional
-        Receives one line per stage (progress).
+    progress : bool
+        Print one line per stage on stderr.
 
     Returns
     -------
@@ -692,7 +693,7 @@ def run_discrepancy(
     started_at = _dt.datetime.now()
     opts = options or DiscrepancyOptions()
     check_options(opts)
-    say = log or (lambda _msg: None)
+    say = progress_lines(progress)
     loaded = load(store, prep, trials, samples, opts.passive)
     model = model or SimConfig()
     name = name or default_name(started_at)
