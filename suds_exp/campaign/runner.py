@@ -248,20 +248,8 @@ def run_campaign(
         summary.extra["skipped_cells"] = plan.definition.get("skipped_cells", [])
         _record_start(store, plan, stored is None, total, backend, n_workers, pending)
         if pending:
-            _execute(
-                store,
-                plan,
-                bank,
-                chunks,
-                summary,
-                jobs,
-                backend,
-                scheduler,
-                batch_rows,
-                flush_seconds,
-                progress,
-                on_batch,
-            )
+            how = _How(jobs, backend, scheduler, batch_rows, flush_seconds, progress, on_batch)
+            _execute(store, plan, bank, chunks, summary, how)
     summary.seconds = time.perf_counter() - started
     return summary
 
@@ -430,20 +418,20 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
     return gen
 
 
-def _execute(
-    store,
-    plan,
-    bank,
-    chunks,
-    summary,
-    jobs,
-    backend,
-    scheduler,
-    batch_rows,
-    flush_seconds,
-    progress,
-    on_batch,
-) -> None:
+@dataclass(frozen=True)
+class _How:
+    """How `_execute` runs the chunks and writes their rows (see `run_campaign`)."""
+
+    jobs: int
+    backend: str
+    scheduler: str | None
+    batch_rows: int
+    flush_seconds: float
+    progress: bool
+    on_batch: object
+
+
+def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
     buffer: list[dict] = []
 
     def flush(final: bool = False):
@@ -466,15 +454,15 @@ def _execute(
             summary.batches += 1
             buffer.clear()
         summary.flush_seconds += time.perf_counter() - t0
-        if on_batch is not None:
-            on_batch(len(frame))
+        if how.on_batch is not None:
+            how.on_batch(len(frame))
 
     with (
         _Signals() as signals,
         progress_bar(
             f"campaign {plan.name}",
             summary.total_jobs,
-            enabled=progress,
+            enabled=how.progress,
             done=summary.done_before,
             unit="jobs",
         ) as advance,
@@ -482,10 +470,16 @@ def _execute(
         last = time.monotonic()
         try:
             with contextlib.ExitStack() as stack:
-                for rows in _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack):
+                rows_iter = _results_iter(
+                    bank, chunks, plan, how.jobs, how.backend, how.scheduler, stack
+                )
+                for rows in rows_iter:
                     buffer.extend(rows)
                     advance(len(rows))
-                    if len(buffer) >= batch_rows or time.monotonic() - last >= flush_seconds:
+                    if (
+                        len(buffer) >= how.batch_rows
+                        or time.monotonic() - last >= how.flush_seconds
+                    ):
                         flush()
                         last = time.monotonic()
         except KeyboardInterrupt:
