@@ -7,6 +7,7 @@ Each command parses options and calls one library function; the work lives in
 from __future__ import annotations
 
 import functools
+import re
 from pathlib import Path
 from typing import Annotated
 
@@ -35,21 +36,39 @@ JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON documen
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 
 
-#: Library parameters whose flag is not simply ``--`` + the name with dashes.
-FLAGS: dict[str, str] = {}
+#: Library parameters whose flag is not simply ``--`` + the name with dashes (in every
+#: command; a command adds its own with ``@command(flags=...)``).
+FLAGS: dict[str, str] = {
+    "effects": "--effect",
+    "params": "--param",
+    "model_params": "--model-param",
+}
 
 
-def user_message(exc: SudsError) -> str:
-    """The error's one line in the CLI's words: a leading Python parameter name (the
-    error's ``param``) becomes its flag."""
-    text, param = str(exc), getattr(exc, "param", None)
-    if not param or param.startswith("-") or not text.startswith(param):
+def flag(param: str, flags: dict[str, str] | None = None) -> str:
+    """The command-line flag of library parameter ``param`` (``max_effects`` ->
+    ``--max-effects``), looked up in ``flags`` and then `FLAGS`."""
+    return {**FLAGS, **(flags or {})}.get(param, "--" + param.replace("_", "-"))
+
+
+def user_message(exc: SudsError, flags: dict[str, str] | None = None) -> str:
+    """The error's one line in the CLI's words: each Python parameter name it is about
+    (the error's ``param``, one name or several) becomes its flag where the text first
+    names it as a word (later uses are ordinary words: "preset papers: unknown preset")."""
+    text, params = str(exc), getattr(exc, "param", None)
+    if not params:
         return text
-    return FLAGS.get(param, "--" + param.replace("_", "-")) + text[len(param) :]
+    for param in (params,) if isinstance(params, str) else params:
+        if param.startswith("-"):
+            continue
+        word = rf"(?<![\w.'\"=/\\-]){re.escape(param)}(?![\w'\"/\\-])"
+        text = re.sub(word, flag(param, flags), text, count=1)
+    return text
 
 
-def command(*args, **kwargs):
-    """`app.command` that turns a `SudsError` into one line on stderr and exit code 2."""
+def command(*args, flags: dict[str, str] | None = None, **kwargs):
+    """`app.command` that turns a `SudsError` into one line on stderr and exit code 2;
+    ``flags`` maps this command's library parameters to flags where `flag` would not."""
 
     def wrap(fn):
         @functools.wraps(fn)
@@ -58,7 +77,7 @@ def command(*args, **kwargs):
                 return fn(*a, **kw)
             except SudsError as exc:
                 console.err.print(
-                    f"[red]error:[/red] {user_message(exc)}", markup=True, highlight=False
+                    f"[red]error:[/red] {user_message(exc, flags)}", markup=True, highlight=False
                 )
                 raise typer.Exit(2) from None
 
@@ -180,7 +199,7 @@ SimConfigOption = Annotated[
 ]
 
 
-@command()
+@command(flags={"frequencies_hz": "--freqs"})
 def simulate(
     out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
     config: SimConfigOption = None,
@@ -204,20 +223,30 @@ def simulate(
     Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on
     """
     from suds_exp.progress import progress_bar
-    from suds_exp.sim.commands import parse_freqs, parse_gaits, simulate_command
+    from suds_exp.sim.commands import (
+        build_config,
+        parse_cycles,
+        parse_freqs,
+        parse_gaits,
+        simulate_command,
+    )
+    from suds_exp.sim.schedule import split_effects
 
-    n = len(parse_gaits(gaits)) * len(parse_freqs(freqs)) * repeats
+    gait_list, freq_list, cycle_range = parse_gaits(gaits), parse_freqs(freqs), parse_cycles(cycles)
+    static, changes = split_effects(effect or [])
+    sim_config = build_config(config, static)
+    n = len(gait_list) * len(freq_list) * repeats
     bar = progress_bar("Simulating", total=n, enabled=not (quiet or json_), unit="trials")
     with bar as advance:
         summary = simulate_command(
             out,
-            config,
-            gaits,
-            freqs,
+            sim_config,
+            gait_list,
+            freq_list,
             repeats,
-            cycles,
+            cycle_range,
             seed,
-            effect or [],
+            changes,
             store=open_store(db) if ingest else None,
             progress=lambda done, total: advance(),
         )
@@ -231,7 +260,7 @@ def simulate(
         )
 
 
-@command()
+@command(flags={"half_range": "--range"})
 def connection(
     out: Annotated[Path, typer.Option(help="CSV file; figures go beside it (_vx/_vy/_wz.png).")],
     grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,
@@ -245,9 +274,9 @@ def connection(
 
     Example: suds-exp connection --out reports/connection.csv --geometry classic
     """
-    from suds_exp.sim.commands import connection_command
+    from suds_exp.sim.commands import build_config, connection_command
 
-    summary = connection_command(out, grid, range_, geometry, config, effect or [])
+    summary = connection_command(out, grid, range_, geometry, build_config(config, effect or []))
     if json_:
         console.print_json(summary)
     else:
@@ -270,7 +299,9 @@ def effects(
     if json_:
         console.print_json(effect_library(build_config(config, effect or [])))
     else:
-        console.print_frame(effects_table(config, effect or []), title="effects (* = main)")
+        console.print_frame(
+            effects_table(build_config(config, effect or [])), title="effects (* = main)"
+        )
 
 
 @command()
@@ -482,7 +513,7 @@ def status(
         print_status(report)
 
 
-@command()
+@command(flags={"n_cycles": "--cycles", "paper_dir": "--paper"})
 def report(
     name: Annotated[str, typer.Argument(help="Campaign name.")],
     out: Annotated[Path | None, typer.Option(help="Folder (default: reports/NAME).")] = None,
@@ -512,7 +543,7 @@ def report(
         console.out.print(f"wrote {index}")
 
 
-@command()
+@command(flags={"n_boot": "--boot"})
 def findings(
     name: Annotated[str, typer.Argument(help="Campaign name.")],
     boot: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
@@ -535,7 +566,7 @@ def findings(
         print_findings(table, name)
 
 
-@command()
+@command(flags={"exclude": "--exclude-candidates", "model_effects": "--model-effect"})
 def discrepancy(
     model: Annotated[
         Path | None, typer.Option("--model", help="Starting simulator config (default: nominal).")
@@ -582,11 +613,10 @@ def discrepancy(
     """
     from suds_exp.discrepancy import DiscrepancyOptions, parse_trial_ids, run_discrepancy
     from suds_exp.discrepancy.discover import DiscoverySettings
-    from suds_exp.discrepancy.workflow import parse_exclude
+    from suds_exp.discrepancy.workflow import default_name, parse_exclude
     from suds_exp.sim.commands import build_config
 
-    start = build_config(model, model_effect or [])
-    say = (lambda line: None) if (quiet or json_) else console.err.print
+    start = build_config(model, model_effect or [], param="model_effects")
     # options are checked before the database is opened
     options = DiscrepancyOptions(
         alpha=alpha,
@@ -596,6 +626,9 @@ def discrepancy(
         discover=discover,
         discovery=DiscoverySettings(max_terms=max_terms),
     )
+    name = name or default_name()
+    if out is None:
+        out = Path("reports") / (name if name.startswith("discrepancy") else f"discrepancy-{name}")
     result = run_discrepancy(
         open_store(db),
         prep,
@@ -604,8 +637,7 @@ def discrepancy(
         trials=parse_trial_ids(trials),
         options=options,
         out=out,
-        default_out=Path("reports"),
-        log=say,
+        progress=not (quiet or json_),
     )
     if json_:
         console.print_json(result.to_json())
@@ -636,7 +668,7 @@ def demo(
     Simulates the paper's design into a temporary folder, ingests it, preprocesses it,
     runs a small campaign with all five learners and writes its report.
     """
-    from suds_exp.demo import run_demo
+    from suds_exp.testing.demo import run_demo
 
     say = (lambda line: None) if json_ else console.out.print
     summary = run_demo(open_store(db), out, jobs=jobs, progress=not (quiet or json_), say=say)
@@ -650,7 +682,7 @@ def demo(
 
 
 # -- stream (online learners on a changing robot) ------------------------------------------
-@command()
+@command(flags={"warmup_cycles": "--warmup"})
 def stream(
     name: Annotated[str, typer.Argument(help="Stream name (created, or continued).")],
     models: Annotated[

@@ -5,7 +5,7 @@ Usage::
 
     .venv/bin/python benchmarks/campaign.py [--repeats 3] [--no-projection] [--json]
 
-Data: the models' synthetic swimmer (`suds_exp.models.synthetic.make_samples`), 5 gaits
+Data: the models' synthetic swimmer (`suds_exp.testing.synthetic_swimmer.make_samples`), 5 gaits
 x 3 frequencies x 4 trials x 25 cycles captured at 100 Hz, so after decimation every
 cycle has 100 samples as in the paper's data. Figures:
 
@@ -63,10 +63,10 @@ from suds_exp.campaign.definition import LEARNERS, resolve_models  # noqa: E402
 from suds_exp.campaign.job import RESULT_COLUMNS  # noqa: E402
 from suds_exp.campaign.sampling import draw_sample  # noqa: E402
 from suds_exp.models import make_model  # noqa: E402
-from suds_exp.models.synthetic import make_samples  # noqa: E402
 from suds_exp.robot import FREQUENCIES_HZ as FREQS  # noqa: E402
 from suds_exp.robot import GAITS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
+from suds_exp.testing.synthetic_swimmer import make_samples  # noqa: E402
 
 SMALL = "O@1/3,O@1,D+@0.5,S-@1"
 BOOTS = 3

@@ -129,7 +129,7 @@ def main() -> None:
         name="hatton",
         options=DiscrepancyOptions(seed=args.seed),
         out=args.out / "report",
-        log=print,
+        progress=True,
     )
     doc = res.to_json()
     summary = {

@@ -39,7 +39,7 @@ from suds_exp.analysis.findings import (  # noqa: E402
     findings_headline,
     findings_summary,
 )
-from suds_exp.analysis.tables import to_markdown  # noqa: E402
+from suds_exp.analysis.formatting import to_markdown  # noqa: E402
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 

@@ -10,7 +10,7 @@ r_a = (phi1, phi2), r_p = the four flipper angles (k = 4), rates by central diff
 phase = commanded phase, every condition decimated to 100 samples per cycle as the
 campaign does, and Gaussian noise of 1 mm/s on vx, vy and 0.01 rad/s on wz (the
 simulator's velocities are exact). `--data synthetic` uses the closed-form
-rate-independent swimmer of `suds_exp.models.synthetic` (passive="travel",
+rate-independent swimmer of `suds_exp.testing.synthetic_swimmer` (passive="travel",
 velocity="finsler") instead.
 
 Sections:
@@ -45,8 +45,8 @@ import pandas as pd
 from suds_exp.campaign.definition import SURVEY_LEARNERS
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
-from suds_exp.models.synthetic import make_samples
 from suds_exp.robot import LEARNERS
+from suds_exp.testing.synthetic_swimmer import make_samples
 
 SAMPLES_PER_CYCLE = 100
 #: The learners `--models survey` adds to the paper's five.

@@ -104,10 +104,9 @@ def gait_cases(seed: int, frequencies=(1 / 3, 0.5, 1.0)) -> dict[str, dict]:
     out = {}
     with tempfile.TemporaryDirectory(prefix="suds-phaser-bench-") as tmp:
         store = Store(Path(tmp) / "bench.duckdb")
-        freqs = ",".join(f"{f:g}" for f in frequencies)
         simulate_command(
-            Path(tmp) / "data", gaits="D+", freqs=freqs, repeats=6, cycles="12:16",
-            seed=seed, store=store,
+            Path(tmp) / "data", gaits=["D+"], frequencies_hz=frequencies, repeats=6,
+            cycles=(12, 16), seed=seed, store=store,
         )  # fmt: skip
         preprocess(store, progress=False)
         samples = load_samples(store, 1)

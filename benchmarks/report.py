@@ -15,8 +15,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from suds_exp.analysis import synthetic_results, write_report
+from suds_exp.analysis import write_report
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_results import synthetic_results
 
 N_CYCLES = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 21, 30, 39, 48)  # the paper's sweep
 TARGET_S = 60.0

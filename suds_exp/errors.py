@@ -9,11 +9,12 @@ expected; the CLI prints it and exits with status 2 without a traceback.
 class SudsError(Exception):
     """Base class of every user-facing error in suds-exp.
 
-    ``param`` names the Python parameter the error is about, when the message starts
-    with it; the CLI then shows that parameter's flag instead (``trials`` -> ``--trials``).
+    ``param`` names the Python parameter(s) the error is about (one name or a tuple), as
+    the message writes them; the CLI shows each one's flag instead (``trials`` ->
+    ``--trials``).
     """
 
-    def __init__(self, message: str = "", *, param: str | None = None):
+    def __init__(self, message: str = "", *, param: str | tuple[str, ...] | None = None):
         super().__init__(message)
         self.param = param
 
@@ -28,3 +29,31 @@ class StoreError(SudsError):
 
 class ConfigError(SudsError):
     """A configuration file, option or parameter has an invalid value."""
+
+
+class PreprocessError(SudsError):
+    """A trial cannot be preprocessed (gap too long, marker missing) or a version is unknown."""
+
+
+class ModelError(SudsError):
+    """A samples frame cannot be used by a learner as given (missing column, too few rows)."""
+
+
+class CampaignError(SudsError):
+    """A campaign cannot be created, continued or run as asked."""
+
+
+class AnalysisError(SudsError):
+    """A campaign, option or table cannot be analysed as asked."""
+
+
+class DiscrepancyError(SudsError):
+    """The discrepancy workflow cannot run as asked (options, trials, versions)."""
+
+
+class StreamError(SudsError):
+    """A stream cannot run as asked (bad option, definition differs from the stored one)."""
+
+
+class BodyError(SudsError):
+    """A body description that cannot be used."""

@@ -31,6 +31,15 @@ class _RateColumn(ProgressColumn):
         return Text(f"-- {self.unit}/s" if speed is None else f"{speed:.2f} {self.unit}/s")
 
 
+def progress_lines(enabled: bool = True) -> Callable[[str], None]:
+    """``say(line)`` for work that reports stages rather than counts: prints each line on
+    stderr when enabled (the switch a function's ``progress`` parameter sets), else
+    nothing."""
+    if not enabled:
+        return lambda _line: None
+    return lambda line: console.err.print(line, markup=False, highlight=False)
+
+
 @contextmanager
 def progress_bar(
     label: str, total: int, enabled: bool = True, done: int = 0, unit: str = "items"

@@ -16,9 +16,10 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from suds_exp.analysis import load_results, synthetic_results
+from suds_exp.analysis import load_results
 from suds_exp.analysis.findings import FINDINGS, findings, findings_summary, findings_table
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_results import synthetic_results
 
 # TLS 100, TLS+SUDS 30, GMR 50, GMR+SUDS 20, phase-only 210 (100 ln mm/s) at 30 cycles
 PLANTED = {"Intercept": 100.0, "SUDS": -70.0, "GMR": -50.0, "SUDS:GMR": 40.0}

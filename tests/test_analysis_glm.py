@@ -17,8 +17,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from suds_exp.analysis import glm_table, load_results, slope_table, synthetic_results
+from suds_exp.analysis import glm_table, load_results, slope_table
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_results import synthetic_results
 
 DIRECT_TERMS = [
     "SUDS",

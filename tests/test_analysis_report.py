@@ -16,8 +16,8 @@ from matplotlib.image import imread
 from typer.testing import CliRunner
 
 from cli import app
-from suds_exp.analysis import synthetic_results
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_results import synthetic_results
 
 runner = CliRunner()
 FIGURES = ["boxplot_frequency", "boxplot_gait", "boxplot_combined", "sample_efficiency"]

@@ -15,9 +15,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from suds_exp.analysis import AnalysisError, iqr_table, load_results, synthetic_results
+from suds_exp.analysis import AnalysisError, iqr_table, load_results
 from suds_exp.store import Store
 from suds_exp.store.migrate import available_migrations
+from suds_exp.testing.synthetic_results import synthetic_results
 
 GAITS = ["S+", "S-", "O", "D-", "D+"]
 FREQS = [0.333333, 0.5, 1.0]

@@ -163,8 +163,8 @@ def test_option_strings():
     with pytest.raises(CampaignError, match="S-@0.5"):
         select_conditions("S-@0.5", have, "--train-conditions")
     with pytest.raises(CampaignError, match="gait 'Q'"):
-        select_conditions("Q@1", have, "--train-conditions")
-    assert parse_int_list("1-3,10", "--sweep") == [1, 2, 3, 10]
-    assert parse_int_list("paper", "--sweep") == [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 21, 30, 39, 48]
-    with pytest.raises(CampaignError, match="--sweep"):
-        parse_int_list("1,x", "--sweep")
+        select_conditions("Q@1", have, "train_conditions")
+    assert parse_int_list("1-3,10", "sweep") == [1, 2, 3, 10]
+    assert parse_int_list("paper", "sweep") == [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 21, 30, 39, 48]
+    with pytest.raises(CampaignError, match="sweep"):
+        parse_int_list("1,x", "sweep")

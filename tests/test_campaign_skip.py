@@ -45,7 +45,7 @@ def test_default_refuses_and_leaves_the_database_as_it_was(db, samples, room):
     store = Store(db)
     store.upgrade()
     before = dump_db(db)
-    with pytest.raises(CampaignError, match=r"D\+@0\.5: .*--skip-infeasible"):
+    with pytest.raises(CampaignError, match=r"D\+@0\.5: .*skip_infeasible"):
         run_campaign(store, "c", options(room), samples=samples, progress=False)
     assert_same_db(before, dump_db(db))
 

@@ -17,10 +17,10 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from suds_exp.discrepancy.demo import simulate_measured
 from suds_exp.discrepancy.effects import effect_names
 from suds_exp.sim.config import SimConfig
 from suds_exp.store import Store
+from suds_exp.testing.hidden_effects import simulate_measured
 
 runner = CliRunner()
 SMALL = dict(gaits=("S+", "D+"), frequencies_hz=(0.5, 1.0), repeats=3, cycles=(3, 4))

@@ -9,7 +9,7 @@ from sklearn.base import clone
 
 from suds_exp.errors import ConfigError, SudsError
 from suds_exp.models import MODEL_NAMES, ModelError, make_model
-from suds_exp.models.synthetic import make_samples
+from suds_exp.testing.synthetic_swimmer import make_samples
 
 VARIANTS = [(name, {}) for name in MODEL_NAMES] + [
     ("TLS+SUDS", {"mode": "rollout"}),

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from suds_exp.models import MODEL_NAMES, make_model
-from suds_exp.models.synthetic import make_samples
+from suds_exp.testing.synthetic_swimmer import make_samples
 
 SIZES = (2, 10, 60)
 

@@ -6,7 +6,7 @@ import pytest
 
 from suds_exp.models import ModelError, make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
-from suds_exp.models.synthetic import make_samples
+from suds_exp.testing.synthetic_swimmer import make_samples
 
 
 def _random_mixture(rng, K, D):

@@ -10,7 +10,7 @@ from sklearn.base import clone
 
 from suds_exp.errors import ConfigError
 from suds_exp.models import GMR, GMRSuds, ModelError, OnlineGMR, OnlineGMRSuds, make_model
-from suds_exp.models.synthetic import make_samples
+from suds_exp.testing.synthetic_swimmer import make_samples
 
 #: Agreement of a stream of partial fits (forgetting off) with one batch fit on the same
 #: data: the test-set RMSE of vx of the two may differ by at most AGREE_RMSE of the batch

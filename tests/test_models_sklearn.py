@@ -15,8 +15,8 @@ import cli
 from suds_exp.campaign import CampaignOptions, run_campaign
 from suds_exp.errors import ConfigError
 from suds_exp.models import make_model, model_recipe
-from suds_exp.models.synthetic import make_samples
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_swimmer import make_samples
 from tests.conftest import dump_db
 from tests.test_campaign_grid import synthetic_samples
 from tests.test_campaign_kill import start, wait_batches

@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 
 from suds_exp.models import make_model
-from suds_exp.models.synthetic import connection, make_samples
 from suds_exp.models.tls import tls_solve
+from suds_exp.testing.synthetic_swimmer import connection, make_samples
 
 
 def _tiny_problem(rng, n=40):

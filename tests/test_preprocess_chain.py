@@ -14,7 +14,7 @@ from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.kinematics import kinematics, measure
 from suds_exp.preprocess.params import DEFAULTS, resolve_params
 from suds_exp.preprocess.rates import body_velocity, derivative, local_polynomial
-from suds_exp.preprocess.synthetic import synthetic_trial
+from suds_exp.testing.synthetic_captures import synthetic_trial
 
 GAITS = [("O", 0.5), ("D+", 1.0), ("S+", 1 / 3), ("D-", 0.5), ("S-", 1.0)]
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
-from suds_exp.preprocess.errors import PreprocessError
-from suds_exp.preprocess.synthetic import synthetic_trial
+from suds_exp.testing.synthetic_captures import synthetic_trial
 
 
 @pytest.mark.parametrize("gait,freq", [("S+", 1.0), ("D+", 1.0), ("O", 1 / 3), ("S-", 0.5)])

@@ -10,7 +10,7 @@ from suds_exp.preprocess.body_frame import SegmentFrames, fit_joints
 from suds_exp.preprocess.kinematics import kinematics, measure
 from suds_exp.preprocess.rates import body_velocity, derivative, smooth, window_frames
 from suds_exp.preprocess.shape import PassivePCA
-from suds_exp.preprocess.synthetic import MIDDLE_MM, synthetic_trial
+from suds_exp.testing.synthetic_captures import MIDDLE_MM, synthetic_trial
 
 GAITS = [("O", 0.5), ("D+", 1.0), ("S+", 1 / 3), ("D-", 0.5), ("S-", 1.0)]
 

@@ -28,7 +28,7 @@ def simulated_store(folder: Path, **design) -> Store:
 @pytest.fixture(scope="module")
 def small(tmp_path_factory) -> Store:
     folder = tmp_path_factory.mktemp("simprep")
-    return simulated_store(folder, freqs="1/2", repeats=1, cycles="10", seed=3)
+    return simulated_store(folder, frequencies_hz=[0.5], repeats=1, cycles=(10, 10), seed=3)
 
 
 def test_simulated_trials_give_shape_and_phase_within_targets(small):

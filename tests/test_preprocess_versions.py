@@ -16,8 +16,8 @@ from typer.testing import CliRunner
 from cli import app
 from suds_exp.ingest import ingest_paths
 from suds_exp.preprocess import PreprocessError, load_samples, pipeline, preprocess, sample_columns
-from suds_exp.preprocess.synthetic import synthetic_trial, write_dataset, write_marker_csv
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_captures import synthetic_trial, write_dataset, write_marker_csv
 from tests.conftest import assert_same_db, dump_db
 
 runner = CliRunner()

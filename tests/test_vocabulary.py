@@ -18,8 +18,8 @@ from suds_exp.errors import ConfigError
 from suds_exp.ingest import ingest_paths
 from suds_exp.preprocess import DEFAULTS, PreprocessError, get_version, preprocess
 from suds_exp.preprocess import parse_trial_ids as prep_trial_ids
-from suds_exp.preprocess.synthetic import write_dataset
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_captures import write_dataset
 
 runner = CliRunner()
 

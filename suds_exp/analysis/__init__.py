@@ -10,14 +10,13 @@ every table of the report is also a function returning a DataFrame::
 """
 
 from suds_exp.analysis.categories import GAIT_AXIS, LEARNERS, category_table, main_cycles
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.analysis.findings import FINDINGS, findings, findings_summary, findings_table
 from suds_exp.analysis.glm import glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import campaigns, load_results
 from suds_exp.analysis.report import iqr_wide, report_tables, write_report
 from suds_exp.analysis.spread import iqr_table, slope_table
-from suds_exp.analysis.synthetic import synthetic_results
+from suds_exp.errors import AnalysisError
 
 __all__ = [
     "FINDINGS",
@@ -40,6 +39,5 @@ __all__ = [
     "paper_table",
     "report_tables",
     "slope_table",
-    "synthetic_results",
     "write_report",
 ]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from suds_exp.analysis.errors import AnalysisError
+from suds_exp.errors import AnalysisError
 from suds_exp.robot import GAITS, LEARNERS
 
 #: The gait axis; gait similarity is the number of steps along it (0 same, 1 near, >1 far).
@@ -47,7 +47,9 @@ def at_cycles(results: pd.DataFrame, n_cycles: int | None) -> tuple[pd.DataFrame
     rows = results[results["n_cycles"] == size]
     if rows.empty:
         sizes = ", ".join(str(v) for v in sorted(results["n_cycles"].unique()))
-        raise AnalysisError(f"--cycles {size}: no results at that size; the campaign has {sizes}")
+        raise AnalysisError(
+            f"n_cycles {size}: no results at that size; the campaign has {sizes}", param="n_cycles"
+        )
     return rows, size
 
 

@@ -35,8 +35,8 @@ import statsmodels.formula.api as smf
 from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import main_cycles
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.analysis.glm import glm_formulas, identifiable_columns
+from suds_exp.errors import AnalysisError
 
 #: Learner names as stored in ``results.model``.
 PHASE, TLS, TLSS, GMR, GMRS = "phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS"
@@ -555,7 +555,7 @@ def findings_table(
     ``seed``.
     """
     if not isinstance(n_boot, int) or n_boot < 0:
-        raise AnalysisError(f"--boot {n_boot!r}: expected an integer >= 0")
+        raise AnalysisError(f"n_boot {n_boot!r}: expected an integer >= 0", param="n_boot")
     if not 0 < confidence < 1:
         raise AnalysisError(f"confidence {confidence!r}: expected a number in (0, 1)")
     results = results[np.isfinite(results["rmse_vx"].to_numpy(float))]

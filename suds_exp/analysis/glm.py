@@ -31,7 +31,7 @@ import statsmodels.formula.api as smf
 from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import at_cycles
-from suds_exp.analysis.errors import AnalysisError
+from suds_exp.errors import AnalysisError
 
 #: Response scales: name -> (description, transform of rmse_vx in mm/s).
 RESPONSES: dict[str, tuple[str, Callable[[np.ndarray], np.ndarray]]] = {

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import kendalltau
 
-from suds_exp.analysis.errors import AnalysisError
+from suds_exp.errors import AnalysisError
 
 PAPER_FILES = {"glm": "glm_table.csv", "iqr": "iqr_table.csv"}
 
@@ -31,7 +31,9 @@ def paper_table(kind: str, paper_dir: Path | None = None) -> pd.DataFrame:
         raise AnalysisError(f"paper table {kind!r}: expected one of {', '.join(PAPER_FILES)}")
     path = Path(paper_dir or default_paper_dir()) / PAPER_FILES[kind]
     if not path.is_file():
-        raise AnalysisError(f"{path}: the paper's {kind} table is not there; pass --paper DIR")
+        raise AnalysisError(
+            f"{path}: the paper's {kind} table is not there; pass paper_dir DIR", param="paper_dir"
+        )
     return pd.read_csv(path)
 
 

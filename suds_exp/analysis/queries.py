@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.campaign.grid import KEY_COLUMNS
+from suds_exp.errors import AnalysisError
 from suds_exp.store import Store
 
 #: Columns of ``results_labelled`` the analyses read (the JSON provenance columns are left

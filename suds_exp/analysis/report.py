@@ -15,13 +15,13 @@ import pandas as pd
 
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.analysis.findings import findings_display, findings_headline, findings_table
+from suds_exp.analysis.formatting import to_html, to_markdown, write_table
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
-from suds_exp.analysis.tables import to_html, to_markdown, write_table
+from suds_exp.errors import AnalysisError
 from suds_exp.store import Store
 
 _SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
@@ -47,7 +47,7 @@ def report_tables(
     `iqr_table`.
     """
     if pairs not in PAIRS:
-        raise AnalysisError(f"--pairs {pairs}: expected one of {', '.join(PAIRS)}")
+        raise AnalysisError(f"pairs {pairs}: expected one of {', '.join(PAIRS)}", param="pairs")
     tables: dict[str, pd.DataFrame] = {
         "findings": findings_table(results, n_boot=findings_boot, upper_from=upper_from),
         "categories": category_table(results, n_cycles),
@@ -164,7 +164,9 @@ def write_report(
     """
     if out_dir is None:
         if not _SAFE_NAME.match(campaign):
-            raise AnalysisError(f"campaign {campaign!r} is not a safe folder name; pass --out DIR")
+            raise AnalysisError(
+                f"campaign {campaign!r} is not a safe folder name; pass out DIR", param="out"
+            )
         out_dir = Path("reports") / campaign
     out = Path(out_dir)
     results = load_results(store, campaign)
@@ -259,9 +261,17 @@ def _esc_join(items: list[str]) -> str:
 
 
 def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
+    parts = _head(campaign, store, results, size)
+    parts += _categories_section(tables, figures, files)
+    parts += _glm_section(tables, files, size)
+    parts += _spread_section(tables, figures, files, pairs)
+    parts += _paper_section(tables, files)
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def _head(campaign, store, results, size) -> list[str]:
     esc = html.escape
-    glm = tables["glm"]
-    refs = glm.attrs["reference"]
     models = ", ".join(learner_order(results["model"]))
     sizes = ", ".join(str(v) for v in sorted(results["n_cycles"].unique()))
     parts = [
@@ -281,12 +291,27 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         "S+, S-, O, D-, D+ (same 0, near 1, far more than 1). Frequency: same or different "
         "training and test frequency. Box plots with matplotlib's default parameters.</p>",
     ]
+    return parts
+
+
+def _categories_section(tables, figures, files) -> list[str]:
+    esc = html.escape
+    parts = []
     for key in ("boxplot_frequency", "boxplot_gait", "boxplot_combined"):
         parts.append(f'<img src="{esc(figures[key].name)}" alt="{esc(key)}">')
     parts += [
         "<h3>Numbers behind the box plots (ln of mm/s)</h3>",
         f"<p>Files: {_files(files['categories'])}</p>",
         to_html(tables["categories"], 3),
+    ]
+    return parts
+
+
+def _glm_section(tables, files, size) -> list[str]:
+    esc = html.escape
+    glm = tables["glm"]
+    refs = glm.attrs["reference"]
+    parts = [
         '<h2 id="glm">2. GLM of log RMS error</h2>',
         f"<p>Response: <code>y = {esc(glm.attrs['response'])}</code> (a coefficient of -10 is "
         "about 10 % less error; independent of the error's unit). Gaussian GLM, identity link, "
@@ -323,6 +348,12 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
         parts.append(to_html(raw[raw["model"] == label].drop(columns="model"), 2))
     parts.append(f"<p>Files: {_files(files['glm_rmse'])}</p>")
 
+    return parts
+
+
+def _spread_section(tables, figures, files, pairs) -> list[str]:
+    esc = html.escape
+    parts = []
     parts.append('<h2 id="spread">3. Spread: IQR of RMS error of vx</h2>')
     if "iqr" in tables:
         parts.append(
@@ -348,6 +379,11 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
             "sample-efficiency figure.</p>"
         )
 
+    return parts
+
+
+def _paper_section(tables, files) -> list[str]:
+    parts = []
     parts.append('<h2 id="paper">5. Beside the paper</h2>')
     if "compare_glm" in tables:
         parts += [
@@ -370,5 +406,4 @@ def _page(campaign, store, results, size, tables, figures, files, pairs) -> str:
             "<p>The paper's tables were not found (pass <code>--paper DIR</code>); "
             "no comparison.</p>"
         )
-    parts.append("</body></html>")
-    return "\n".join(parts)
+    return parts

@@ -14,7 +14,7 @@ import pandas as pd
 from scipy.stats import t as student_t
 
 from suds_exp.analysis.categories import learner_order
-from suds_exp.analysis.errors import AnalysisError
+from suds_exp.errors import AnalysisError
 
 #: Which train/test pairs the spread and efficiency tables pool.
 PAIRS = {

@@ -31,8 +31,8 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.analysis.categories import learner_order
-from suds_exp.analysis.errors import AnalysisError
 from suds_exp.campaign.grid import KEY_COLUMNS
+from suds_exp.errors import AnalysisError
 
 REFERENCE = "GMR"
 OWN_FACTOR = 1.25
@@ -47,7 +47,8 @@ def sweep_rows(results: pd.DataFrame) -> pd.DataFrame:
     if rows["n_cycles"].nunique() < 2:
         raise AnalysisError(
             "survey: the campaign has no sample-efficiency sweep (same-condition results "
-            "at two or more training sizes); run it with --sweep, e.g. --sweep 1,2,4,8,16,30,48"
+            "at two or more training sizes); run it with sweep, e.g. sweep 1,2,4,8,16,30,48",
+            param="sweep",
         )
     return rows
 

@@ -39,17 +39,13 @@ from dataclasses import asdict, dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from suds_exp.errors import SudsError
+from suds_exp.errors import BodyError
 from suds_exp.ingest.layout import ROLES
 
 JOINT_KINDS = ("actuated", "passive")
 UP_AXES = ("x", "y", "z")
 #: Names of the descriptions shipped in the package (``--body swimmer``).
 BUILTIN = ("swimmer",)
-
-
-class BodyError(SudsError):
-    """A body description that cannot be used."""
 
 
 @dataclass(frozen=True)

@@ -26,19 +26,25 @@ import sqlalchemy as sa
 
 from suds_exp.body.chain_shape import chain_geometry
 from suds_exp.body.description import Body, BodyError, check_markers
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
-from suds_exp.preprocess.errors import PreprocessError
-from suds_exp.preprocess.params import params_hash, params_json, resolve_params
+from suds_exp.preprocess.params import params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.pipeline import PrepResult, preprocess, stored_progress, write_pca
+from suds_exp.preprocess.pipeline import (
+    NewFit,
+    PrepResult,
+    find_version,
+    new_result,
+    preprocess,
+    stored_progress,
+    write_trials,
+    write_version,
+)
 from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
     DRP_COLUMNS,
     RP_COLUMNS,
-    prep_fits,
-    prep_trials,
-    prep_versions,
 )
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
@@ -66,7 +72,7 @@ def preprocess_body(
         return preprocess(store, name, params, trials, progress, preset=preset)
     if preset is not None:
         raise BodyError(
-            f"{body.source}: preset {preset!r} describes the swimmer; a chain takes --param only"
+            f"{body.source}: preset {preset!r} describes the swimmer; a chain takes params only"
         )
     if body.chain is None:
         raise BodyError(
@@ -100,45 +106,52 @@ def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResul
     params = resolve_params(given)
     params["body"] = body.to_dict()
     digest = params_hash(params)
-    wanted = None if trials_ is None else sorted({int(i) for i in trials_})
-    v = prep_versions.c
     with store.write() as conn:
-        row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
-        if name is not None:
-            clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
-            if clash is not None and clash.params_hash != digest:
-                raise PreprocessError(
-                    f"--name {name}: version {clash.id} already has that name with other "
-                    "parameters; choose another name"
-                )
-        query = sa.select(
-            trials.c.id, trials.c.source_file, trials.c.sample_rate_hz, trials.c.marker_names
-        ).order_by(trials.c.id)
-        meta = Store.frame(conn, query)
-        if wanted is not None:
-            unknown = sorted(set(wanted) - {int(i) for i in meta.id})
-            if unknown:
-                raise PreprocessError(f"--trials: no trial with id {', '.join(map(str, unknown))}")
-            meta = meta[meta.id.isin(wanted)]
-        if meta.empty:
-            raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+        row = find_version(conn, name, digest)
+        meta = _chain_meta(conn, trials_)
         done, fits = stored_progress(conn, None if row is None else row.id)
         todo = meta[~meta.id.isin(done)]
         for r in todo.itertuples(index=False):
             check_markers(body, list(r.marker_names), f"trial {r.id} ({r.source_file})")
         raw = {int(r.id): _chain_tracks(conn, body, r) for r in todo.itertuples(index=False)}
-    result = PrepResult(
-        version_id=row.id if row is not None else -1,
-        name=row.name if row is not None else (name or ""),
-        params_hash=digest,
-        params=params,
-        created=row is None,
-        skipped=sorted(int(i) for i in meta.id if int(i) in done),
-    )
+    result = new_result(row, name, params, digest, skipped=meta.id[meta.id.isin(done)])
     if todo.empty:
         result.seconds = time.perf_counter() - started
         return result
+    items = _clean_chain(body, todo, raw, params)
+    pca, phasers, new_fits = _fit_chain(body, items, params, fits)
+    write_version(store, result, new_fits, pca, body.chain.modes)
+    with progress_bar("Preprocessing", total=len(items), enabled=progress, unit="trials") as adv:
+        for tid, rate, frames, t, clean, geom in items:
+            vid = result.version_id
+            samples = chain_samples(vid, tid, rate, frames, t, geom, pca, phasers[tid], params)
+            stats = _chain_stats(body, vid, tid, t, clean, geom)
+            write_trials(store, result, samples, pd.DataFrame([stats]))
+            adv()
+    result.explained_variance_ratio = pca.explained_variance_ratio_[: body.chain.modes].tolist()
+    result.seconds = time.perf_counter() - started
+    return result
 
+
+def _chain_meta(conn: sa.Connection, trial_ids) -> pd.DataFrame:
+    query = sa.select(
+        trials.c.id, trials.c.source_file, trials.c.sample_rate_hz, trials.c.marker_names
+    ).order_by(trials.c.id)
+    meta = Store.frame(conn, query)
+    if trial_ids is not None:
+        wanted = sorted({int(i) for i in trial_ids})
+        unknown = sorted(set(wanted) - {int(i) for i in meta.id})
+        if unknown:
+            raise PreprocessError(
+                f"trials: no trial with id {', '.join(map(str, unknown))}", param="trials"
+            )
+        meta = meta[meta.id.isin(wanted)]
+    if meta.empty:
+        raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+    return meta
+
+
+def _clean_chain(body: Body, todo: pd.DataFrame, raw: dict, params: dict) -> list[tuple]:
     items = []
     for r in todo.itertuples(index=False):
         frames, t, xyz = raw[int(r.id)]
@@ -150,15 +163,24 @@ def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResul
         try:
             clean = clean_tracks(xyz, params["jump_mm"], max_gap, body.chain.markers)
         except PreprocessError as exc:
-            raise PreprocessError(f"{label}: {exc}") from None
+            raise PreprocessError(f"{label}: {exc}", param=exc.param) from None
         items.append((int(r.id), rate, frames, t, clean, chain_geometry(clean.xyz, body.chain.up)))
+    return items
+
+
+def _fit_chain(body: Body, items: list[tuple], params: dict, fits: dict):
+    """The shape PCA and one Phaser per trial (stored ones reused) and the new fits."""
+    n_frames = {i[0]: len(i[2]) for i in items}
+
+    def new_fit(kind, grp, state, ids):
+        return NewFit(kind, grp, state, ids, int(sum(n_frames[i] for i in ids)))
 
     new_fits = []
     if ("pca", "") in fits:
         pca = PassivePCA.from_dict(json.loads(fits[("pca", "")]))
     else:
         pca = PassivePCA(body.chain.modes).fit(np.concatenate([g.angles for *_, g in items]))
-        new_fits.append(("pca", "", json.dumps(pca.to_dict()), [i[0] for i in items]))
+        new_fits.append(new_fit("pca", "", json.dumps(pca.to_dict()), [i[0] for i in items]))
     phasers = {}
     for tid, *_, geom in items:
         group = f"trial:{tid}"
@@ -171,74 +193,25 @@ def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResul
             )
         except PreprocessError as exc:
             raise PreprocessError(f"phase of trial {tid}: {exc}") from None
-        new_fits.append(("phaser", group, json.dumps(phasers[tid].to_dict()), [tid]))
+        new_fits.append(new_fit("phaser", group, json.dumps(phasers[tid].to_dict()), [tid]))
+    return pca, phasers, new_fits
 
-    with store.write() as conn:
-        if row is None:
-            vid = int(conn.exec_driver_sql("SELECT nextval('prep_versions_id_seq')").scalar_one())
-            result.name = name or f"v{vid}"
-            conn.execute(
-                sa.insert(prep_versions).values(
-                    id=vid,
-                    name=result.name,
-                    params_hash=digest,
-                    params=params_json(params),
-                    k=params["k"],
-                    created_at=sa.func.current_timestamp(),
-                )
-            )
-            result.version_id = vid
-        vid = result.version_id
-        now = pd.Timestamp.now(tz="UTC").tz_localize(None)
-        if new_fits:
-            n_frames = {i[0]: len(i[2]) for i in items}
-            store.insert_df(
-                conn,
-                prep_fits.name,
-                pd.DataFrame(
-                    [
-                        {
-                            "version_id": vid,
-                            "kind": kind,
-                            "grp": grp,
-                            "state": state,
-                            "trial_ids": ids,
-                            "n_frames": int(sum(n_frames[i] for i in ids)),
-                            "fitted_at": now,
-                        }
-                        for kind, grp, state, ids in new_fits
-                    ]
-                ),
-            )
-        if any(kind == "pca" for kind, *_ in new_fits):
-            write_pca(store, conn, vid, pca, body.chain.modes)
 
-    with progress_bar("Preprocessing", total=len(items), enabled=progress, unit="trials") as adv:
-        for tid, rate, frames, t, clean, geom in items:
-            samples = chain_samples(vid, tid, rate, frames, t, geom, pca, phasers[tid], params)
-            stats = {
-                "version_id": vid,
-                "trial_id": tid,
-                "n_frames": len(t),
-                "n_jumps": clean.n_jumps,
-                "removed_fraction": clean.removed_fraction,
-                "filled_fraction": clean.filled_fraction,
-                "longest_gap_frames": clean.longest_gap,
-                "plane_normal": [float(a == body.chain.up) for a in "xyz"],
-                "middle_length_mm": float(geom.length.mean()),
-                "joint_rms_mm": float(geom.length.std()),
-                "phaser_group": f"trial:{tid}",
-                "done_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
-            }
-            with store.write() as conn:
-                store.insert_df(conn, "samples", samples)
-                store.insert_df(conn, prep_trials.name, pd.DataFrame([stats]))
-            result.processed.append(tid)
-            result.n_samples += len(samples)
-            adv()
-    result.explained_variance_ratio = pca.explained_variance_ratio_[: body.chain.modes].tolist()
-    result.seconds = time.perf_counter() - started
-    return result
+def _chain_stats(body: Body, vid: int, tid: int, t, clean, geom) -> dict:
+    return {
+        "version_id": vid,
+        "trial_id": tid,
+        "n_frames": len(t),
+        "n_jumps": clean.n_jumps,
+        "removed_fraction": clean.removed_fraction,
+        "filled_fraction": clean.filled_fraction,
+        "longest_gap_frames": clean.longest_gap,
+        "plane_normal": [float(a == body.chain.up) for a in "xyz"],
+        "middle_length_mm": float(geom.length.mean()),
+        "joint_rms_mm": float(geom.length.std()),
+        "phaser_group": f"trial:{tid}",
+        "done_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
+    }
 
 
 def chain_samples(vid, tid, rate, frames, t, geom, pca, phaser, params) -> pd.DataFrame:

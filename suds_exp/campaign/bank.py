@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.campaign.conditions import Condition, condition_sort_key, format_condition, round_hz
-from suds_exp.campaign.errors import CampaignError
+from suds_exp.errors import CampaignError
 from suds_exp.robot import SAMPLE_KEYS, VB_COLUMNS
 
 _RP = re.compile(r"^d?rp_\d+$")

@@ -8,8 +8,7 @@ frequency present) or ``@FREQ`` (every gait at that frequency); FREQ may be a fr
 
 from __future__ import annotations
 
-from suds_exp.campaign.errors import CampaignError
-from suds_exp.errors import ConfigError
+from suds_exp.errors import CampaignError, ConfigError
 from suds_exp.robot import GAITS, parse_frequency, parse_ids
 
 Condition = tuple[str, float]
@@ -35,7 +34,8 @@ def _parse_hz(text: str, option: str) -> float:
         value = parse_frequency(text)
     except ValueError:
         raise CampaignError(
-            f"{option}: frequency {text!r} is not a positive number; write e.g. 0.5 or 1/3"
+            f"{option}: frequency {text!r} is not a positive number; write e.g. 0.5 or 1/3",
+            param=option,
         ) from None
     return round_hz(value)
 
@@ -57,14 +57,16 @@ def select_conditions(spec: str | None, available: list[Condition], option: str)
         gait = gait.strip()
         if gait and gait not in GAITS:
             raise CampaignError(
-                f"{option}: gait {gait!r} in {item!r}; expected one of {' '.join(GAITS)}"
+                f"{option}: gait {gait!r} in {item!r}; expected one of {' '.join(GAITS)}",
+                param=option,
             )
         f = _parse_hz(hz, option) if hz.strip() else None
         match = [c for c in pool if (not gait or c[0] == gait) and (f is None or c[1] == f)]
         if not match:
             have = ", ".join(format_condition(c) for c in pool) or "none"
             raise CampaignError(
-                f"{option}: {item!r} matches no condition in the samples (have: {have})"
+                f"{option}: {item!r} matches no condition in the samples (have: {have})",
+                param=option,
             )
         chosen.update(match)
     return sorted(chosen, key=condition_sort_key)
@@ -80,7 +82,7 @@ def parse_int_list(spec: str | None, option: str) -> list[int]:
     try:
         return parse_ids(spec, option)
     except ConfigError as exc:
-        raise CampaignError(str(exc)) from None
+        raise CampaignError(str(exc), param=exc.param) from None
 
 
 #: Training cycles of the paper's sample-efficiency figure.

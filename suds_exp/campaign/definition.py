@@ -22,12 +22,12 @@ from suds_exp.campaign.conditions import (
     parse_int_list,
     select_conditions,
 )
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.sampling import infeasible_cells
+from suds_exp.errors import CampaignError
 from suds_exp.robot import LEARNERS
 
 MODES = ("measured", "rollout")
-#: `--models survey`: the paper's five and the survey's scikit-learn baselines.
+#: ``models="survey"``: the paper's five and the survey's scikit-learn baselines.
 SURVEY_LEARNERS = (*LEARNERS, "MLP", "MLP+SUDS", "GBT", "kNN", "KRR")
 DEFINITION_VERSION = 1
 
@@ -84,7 +84,7 @@ class CampaignOptions:
         names = None if models is None else [m.strip() for m in models.split(",") if m.strip()]
         if names is not None:
             names = [n for m in names for n in (SURVEY_LEARNERS if m == "survey" else (m,))]
-        cycles = None if sweep is None else parse_int_list(sweep, "--sweep")
+        cycles = None if sweep is None else parse_int_list(sweep, "sweep")
         chosen = names
         if model_params:
             chosen = parse_model_params(model_params, names or list(LEARNERS))
@@ -109,11 +109,13 @@ def parse_model_params(items: Sequence[str], names: Sequence[str]) -> dict[str, 
         name, dot, key = left.strip().rpartition(".")
         if not eq or not dot or not name or not key:
             raise CampaignError(
-                f"--model-param {item!r}: expected NAME.KEY=VALUE, e.g. MLP.alpha=0.01"
+                f"model_params {item!r}: expected NAME.KEY=VALUE, e.g. MLP.alpha=0.01",
+                param="model_params",
             )
         if name not in out:
             raise CampaignError(
-                f"--model-param {item!r}: learner {name!r} is not in --models ({', '.join(names)})"
+                f"model_params {item!r}: learner {name!r} is not in models ({', '.join(names)})",
+                param=("model_params", "models"),
             )
         try:
             value = json.loads(text)
@@ -162,13 +164,13 @@ def resolve_models(models, mode: str) -> dict[str, dict]:
     out: dict[str, dict] = {}
     for name, params in items:
         if name in out:
-            raise CampaignError(f"--models: {name!r} is listed twice")
+            raise CampaignError(f"models: {name!r} is listed twice", param="models")
         model = make_model(name, **dict(params or {}))
         if "mode" in model.get_params(deep=False):
             model.set_params(mode=mode)
         out[name] = json.loads(json.dumps(model_recipe(model), default=_json_default))
     if not out:
-        raise CampaignError("--models: no learner given; expected e.g. TLS,GMR")
+        raise CampaignError("models: no learner given; expected e.g. TLS,GMR", param="models")
     return out
 
 
@@ -212,14 +214,16 @@ def make_plan(
     """
     if not name or not name.strip():
         raise CampaignError("campaign NAME must not be empty")
-    _check_int("--boots", options.boots, 1)
-    _check_int("--train-cycles", options.train_cycles, 1)
+    _check_int("boots", options.boots, 1)
+    _check_int("train_cycles", options.train_cycles, 1)
     for n in options.sweep:
-        _check_int("--sweep", n, 1)
+        _check_int("sweep", n, 1)
     if options.mode not in MODES:
-        raise CampaignError(f"--mode: {options.mode!r}; expected one of {', '.join(MODES)}")
-    train = _conditions(options.train_conditions, available, "--train-conditions")
-    test = _conditions(options.test_conditions, available, "--test-conditions")
+        raise CampaignError(
+            f"mode: {options.mode!r}; expected one of {', '.join(MODES)}", param="mode"
+        )
+    train = _conditions(options.train_conditions, available, "train_conditions")
+    test = _conditions(options.test_conditions, available, "test_conditions")
     models = resolve_models(options.models, options.mode)
     bank = bank_for(sorted(set(train) | set(test)))
     sweep = sorted({int(n) for n in options.sweep})
@@ -236,7 +240,8 @@ def make_plan(
     skipped: list = []
     if not isinstance(options.skip_infeasible, bool):
         raise CampaignError(
-            f"--skip-infeasible: {options.skip_infeasible!r}; expected true or false"
+            f"skip_infeasible: {options.skip_infeasible!r}; expected true or false",
+            param="skip_infeasible",
         )
     if options.skip_infeasible:
         # Stored only when asked for, so the definitions of earlier campaigns (which have
@@ -279,7 +284,7 @@ def _conditions(value, available, option) -> list[Condition]:
 
 def _check_int(option: str, value, low: int) -> None:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
-        raise CampaignError(f"{option}: {value!r}; expected an integer >= {low}")
+        raise CampaignError(f"{option}: {value!r}; expected an integer >= {low}", param=option)
 
 
 def differences(stored: dict, new: dict, prefix: str = "") -> list[str]:

@@ -14,7 +14,7 @@ import socket
 import time
 from pathlib import Path
 
-from suds_exp.campaign.errors import CampaignError
+from suds_exp.errors import CampaignError
 
 #: How long a new run waits for the lock before refusing, in s (covers a `status` probe).
 ACQUIRE_WAIT_S = 1.0

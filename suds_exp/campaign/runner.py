@@ -43,12 +43,11 @@ from suds_exp.campaign.definition import (
     normalise,
     skipped_cells_text,
 )
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
-from suds_exp.errors import StoreError
+from suds_exp.errors import CampaignError, StoreError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 
@@ -227,72 +226,79 @@ def run_campaign(
     -------
     RunSummary
     """
-    if backend not in BACKENDS:
-        raise CampaignError(f"--backend: {backend!r}; expected one of {', '.join(BACKENDS)}")
-    if scheduler and backend != "dask":
-        raise CampaignError("--scheduler needs --backend dask")
-    if jobs == 0 or jobs < -1:
-        raise CampaignError(f"--jobs: {jobs}; expected a positive number of workers (or -1)")
+    check_backend(backend, scheduler, jobs)
     options = options or CampaignOptions()
     started = time.perf_counter()
     with RunLock(store.path, name):
         store.upgrade()
         stored = load_stored_definition(store, name)
-        options = merge_stored(options, stored)
-        if samples is None:
-            from suds_exp.preprocess import get_version
-
-            version = get_version(store, options.prep)
-            options.prep, samples = version.name, version.samples()
-        elif options.prep is None:
-            options.prep = "(samples given)"
-        plan, bank = make_plan(
-            name, options, rounded_conditions(samples), lambda c: SampleBank.build(samples, c)
-        )
-        if stored is not None:
-            diff = differences(stored, normalise(plan.definition))
-            if diff:
-                raise CampaignError(
-                    f"campaign {name!r} exists with a different definition ("
-                    + "; ".join(diff[:6])
-                    + (f"; and {len(diff) - 6} more" if len(diff) > 6 else "")
-                    + "); continue it with its stored options or choose a new NAME"
-                )
-        # With --skip-infeasible the plan already left out every cell the data cannot
-        # supply; conditions without any complete cycle are refused either way.
-        needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
-        check_feasible(bank, plan.train_conditions, plan.test_conditions, needs)
-        done = finished_keys(store, name)
+        plan, bank = plan_campaign(store, name, merge_stored(options, stored), stored, samples)
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
-            plan, done, chunk_jobs or _default_chunk(plan, n_workers)
+            plan, finished_keys(store, name), chunk_jobs or _default_chunk(plan, n_workers)
         )
         if total == 0:
             raise CampaignError(
-                f"campaign {name!r}: --skip-infeasible left out every cell ("
+                f"campaign {name!r}: skip_infeasible left out every cell ("
                 + skipped_cells_text(plan.definition)
-                + "); lower --train-cycles/--sweep"
+                + "); lower train_cycles/sweep",
+                param=("skip_infeasible", "train_cycles", "sweep"),
             )
         summary = RunSummary(name, total, total - pending, created=stored is None)
         summary.extra["skipped_cells"] = plan.definition.get("skipped_cells", [])
         _record_start(store, plan, stored is None, total, backend, n_workers, pending)
         if pending:
-            _execute(
-                store,
-                plan,
-                bank,
-                chunks,
-                summary,
-                jobs,
-                backend,
-                scheduler,
-                batch_rows,
-                flush_seconds,
-                progress,
-                on_batch,
-            )
+            how = _How(jobs, backend, scheduler, batch_rows, flush_seconds, progress, on_batch)
+            _execute(store, plan, bank, chunks, summary, how)
     summary.seconds = time.perf_counter() - started
     return summary
+
+
+def check_backend(backend: str, scheduler: str | None, jobs: int) -> None:
+    """Raise `CampaignError` for an unknown ``backend``, a ``scheduler`` without dask or
+    a ``jobs`` that is not a number of workers."""
+    if backend not in BACKENDS:
+        raise CampaignError(
+            f"backend: {backend!r}; expected one of {', '.join(BACKENDS)}", param="backend"
+        )
+    if scheduler and backend != "dask":
+        raise CampaignError("scheduler needs backend dask", param=("scheduler", "backend"))
+    if jobs == 0 or jobs < -1:
+        raise CampaignError(
+            f"jobs: {jobs}; expected a positive number of workers (or -1)", param="jobs"
+        )
+
+
+def plan_campaign(
+    store: Store, name: str, options: CampaignOptions, stored: dict | None, samples=None
+) -> tuple[Plan, SampleBank]:
+    """The plan and sample bank of campaign ``name`` with ``options`` (merged with the
+    ``stored`` definition): loads the version's samples unless ``samples`` is given, and
+    refuses a definition that differs from the stored one or data that cannot supply it."""
+    if samples is None:
+        from suds_exp.preprocess import get_version
+
+        version = get_version(store, options.prep)
+        options.prep, samples = version.name, version.samples()
+    elif options.prep is None:
+        options.prep = "(samples given)"
+    plan, bank = make_plan(
+        name, options, rounded_conditions(samples), lambda c: SampleBank.build(samples, c)
+    )
+    if stored is not None:
+        diff = differences(stored, normalise(plan.definition))
+        if diff:
+            raise CampaignError(
+                f"campaign {name!r} exists with a different definition ("
+                + "; ".join(diff[:6])
+                + (f"; and {len(diff) - 6} more" if len(diff) > 6 else "")
+                + "); continue it with its stored options or choose a new NAME"
+            )
+    # With skip_infeasible the plan already left out every cell the data cannot
+    # supply; conditions without any complete cycle are refused either way.
+    needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
+    check_feasible(bank, plan.train_conditions, plan.test_conditions, needs)
+    return plan, bank
 
 
 def _n_workers(jobs: int) -> int:
@@ -412,20 +418,20 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
     return gen
 
 
-def _execute(
-    store,
-    plan,
-    bank,
-    chunks,
-    summary,
-    jobs,
-    backend,
-    scheduler,
-    batch_rows,
-    flush_seconds,
-    progress,
-    on_batch,
-) -> None:
+@dataclass(frozen=True)
+class _How:
+    """How `_execute` runs the chunks and writes their rows (see `run_campaign`)."""
+
+    jobs: int
+    backend: str
+    scheduler: str | None
+    batch_rows: int
+    flush_seconds: float
+    progress: bool
+    on_batch: object
+
+
+def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
     buffer: list[dict] = []
 
     def flush(final: bool = False):
@@ -448,15 +454,15 @@ def _execute(
             summary.batches += 1
             buffer.clear()
         summary.flush_seconds += time.perf_counter() - t0
-        if on_batch is not None:
-            on_batch(len(frame))
+        if how.on_batch is not None:
+            how.on_batch(len(frame))
 
     with (
         _Signals() as signals,
         progress_bar(
             f"campaign {plan.name}",
             summary.total_jobs,
-            enabled=progress,
+            enabled=how.progress,
             done=summary.done_before,
             unit="jobs",
         ) as advance,
@@ -464,10 +470,16 @@ def _execute(
         last = time.monotonic()
         try:
             with contextlib.ExitStack() as stack:
-                for rows in _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack):
+                rows_iter = _results_iter(
+                    bank, chunks, plan, how.jobs, how.backend, how.scheduler, stack
+                )
+                for rows in rows_iter:
                     buffer.extend(rows)
                     advance(len(rows))
-                    if len(buffer) >= batch_rows or time.monotonic() - last >= flush_seconds:
+                    if (
+                        len(buffer) >= how.batch_rows
+                        or time.monotonic() - last >= how.flush_seconds
+                    ):
                         flush()
                         last = time.monotonic()
         except KeyboardInterrupt:

@@ -20,8 +20,8 @@ import numpy as np
 
 from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import Condition, format_condition
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.grid import Draw
+from suds_exp.errors import CampaignError
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,10 @@ def draw_sample(bank: SampleBank, draw: Draw, test_cycles: int) -> Sample:
     return Sample(train=train, test=test)
 
 
+#: The options a feasibility error suggests changing.
+FEASIBILITY_PARAMS = ("train_cycles", "sweep", "skip_infeasible")
+
+
 def check_feasible(
     bank: SampleBank,
     train_conditions: list[Condition],
@@ -85,14 +89,16 @@ def check_feasible(
     for cond in test_conditions:
         if not bank.trials_of(cond):
             raise CampaignError(
-                f"--test-conditions: {format_condition(cond)} has no trial with a complete cycle"
+                f"test_conditions: {format_condition(cond)} has no trial with a complete cycle",
+                param="test_conditions",
             )
     for cond in train_conditions:
         trials = bank.trials_of(cond)
         total = sum(bank.n_cycles(i) for i in trials)
         if not trials:
             raise CampaignError(
-                f"--train-conditions: {format_condition(cond)} has no trial with a complete cycle"
+                f"train_conditions: {format_condition(cond)} has no trial with a complete cycle",
+                param="train_conditions",
             )
         need = max_cycles.get(cond, 0)
         if cond in set(test_conditions):
@@ -101,14 +107,16 @@ def check_feasible(
                 raise CampaignError(
                     f"{format_condition(cond)}: at most {best} complete training cycles remain "
                     f"outside a test trial of the same condition, but {need} are asked; lower "
-                    "--train-cycles/--sweep, leave the condition out, or pass --skip-infeasible to "
-                    "leave out the (condition, size) cells the data cannot supply"
+                    "train_cycles/sweep, leave the condition out, or pass skip_infeasible to "
+                    "leave out the (condition, size) cells the data cannot supply",
+                    param=FEASIBILITY_PARAMS,
                 )
         elif need > total:
             raise CampaignError(
                 f"{format_condition(cond)}: {total} complete cycles in all, but {need} are "
-                "asked; lower --train-cycles/--sweep, leave the condition out, or pass "
-                "--skip-infeasible to leave out the (condition, size) cells the data cannot supply"
+                "asked; lower train_cycles/sweep, leave the condition out, or pass "
+                "skip_infeasible to leave out the (condition, size) cells the data cannot supply",
+                param=FEASIBILITY_PARAMS,
             )
 
 

@@ -8,9 +8,69 @@ from datetime import UTC, datetime
 import pandas as pd
 
 from suds_exp.campaign.definition import skipped_cells_text
-from suds_exp.campaign.errors import CampaignError
 from suds_exp.campaign.lock import run_holder
+from suds_exp.errors import CampaignError
 from suds_exp.store import Store
+
+
+def _read_status(raw, path, name: str):
+    """The campaign's row (definition, number of jobs, version), results per model, the
+    start of its last run and what it finished since."""
+    has = raw.execute(
+        "SELECT count(*) FROM information_schema.tables WHERE table_name = 'campaigns'"
+    ).fetchone()[0]
+    row = (
+        raw.execute(
+            "SELECT definition, n_jobs, prep_version FROM campaigns WHERE name = ?", [name]
+        ).fetchone()
+        if has
+        else None
+    )
+    if row is None:
+        names = (
+            [r[0] for r in raw.execute("SELECT name FROM campaigns ORDER BY 1").fetchall()]
+            if has
+            else []
+        )
+        raise CampaignError(
+            f"no campaign {name!r} in {path} (have: {', '.join(names) or 'none'}); "
+            "start one with `suds-exp run NAME`"
+        )
+    definition, total, prep = json.loads(row[0]), int(row[1]), row[2]
+    per_model = raw.execute(
+        "SELECT model, count(*) AS done, count(error) AS failed FROM results "
+        "WHERE campaign = ? GROUP BY model",
+        [name],
+    ).df()
+    last_run = raw.execute(
+        "SELECT started_at FROM campaign_runs WHERE campaign = ? ORDER BY id DESC LIMIT 1",
+        [name],
+    ).fetchone()
+    started = last_run[0] if last_run else None
+    since = (
+        raw.execute(
+            "SELECT count(*), max(finished_at) FROM results "
+            "WHERE campaign = ? AND finished_at >= ?",
+            [name, started],
+        ).fetchone()
+        if started is not None
+        else (0, None)
+    )
+    return definition, total, prep, per_model, started, since
+
+
+def _model_table(models: list[str], total: int, per_model: pd.DataFrame) -> list[dict]:
+    per_job = total // max(len(models), 1)
+    counts = per_model.set_index("model") if len(per_model) else pd.DataFrame()
+    return [
+        {
+            "model": m,
+            "done": int(counts.loc[m, "done"]) if m in counts.index else 0,
+            "total": per_job,
+            "failed": int(counts.loc[m, "failed"]) if m in counts.index else 0,
+        }
+        for m in models
+    ]
 
 
 def campaign_status(store: Store, name: str) -> dict:
@@ -22,63 +82,14 @@ def campaign_status(store: Store, name: str) -> dict:
     campaign), ``last_run_started`` (UTC), ``rate_jobs_per_s`` (jobs finished per second
     during the last run, None before any), ``eta_s`` (seconds left at that rate while
     running, else None), ``skipped_cells`` (the (condition, training cycles) cells the
-    campaign leaves out, asked for with ``--skip-infeasible``: list of {condition,
+    campaign leaves out, asked for with ``skip_infeasible``: list of {condition,
     n_cycles, pairs}).
     """
     with store.read() as conn:
-        raw = conn.connection.driver_connection
-        has = raw.execute(
-            "SELECT count(*) FROM information_schema.tables WHERE table_name = 'campaigns'"
-        ).fetchone()[0]
-        row = (
-            raw.execute(
-                "SELECT definition, n_jobs, prep_version FROM campaigns WHERE name = ?", [name]
-            ).fetchone()
-            if has
-            else None
+        definition, total, prep, per_model, started, since = _read_status(
+            conn.connection.driver_connection, store.path, name
         )
-        if row is None:
-            names = (
-                [r[0] for r in raw.execute("SELECT name FROM campaigns ORDER BY 1").fetchall()]
-                if has
-                else []
-            )
-            raise CampaignError(
-                f"no campaign {name!r} in {store.path} (have: {', '.join(names) or 'none'}); "
-                "start one with `suds-exp run NAME`"
-            )
-        definition, total, prep = json.loads(row[0]), int(row[1]), row[2]
-        per_model = raw.execute(
-            "SELECT model, count(*) AS done, count(error) AS failed FROM results "
-            "WHERE campaign = ? GROUP BY model",
-            [name],
-        ).df()
-        last_run = raw.execute(
-            "SELECT started_at FROM campaign_runs WHERE campaign = ? ORDER BY id DESC LIMIT 1",
-            [name],
-        ).fetchone()
-        started = last_run[0] if last_run else None
-        since = (
-            raw.execute(
-                "SELECT count(*), max(finished_at) FROM results "
-                "WHERE campaign = ? AND finished_at >= ?",
-                [name, started],
-            ).fetchone()
-            if started is not None
-            else (0, None)
-        )
-    models = list(definition["options"]["models"])
-    per_job = total // max(len(models), 1)
-    counts = per_model.set_index("model") if len(per_model) else pd.DataFrame()
-    table = [
-        {
-            "model": m,
-            "done": int(counts.loc[m, "done"]) if m in counts.index else 0,
-            "total": per_job,
-            "failed": int(counts.loc[m, "failed"]) if m in counts.index else 0,
-        }
-        for m in models
-    ]
+    table = _model_table(list(definition["options"]["models"]), total, per_model)
     done = sum(r["done"] for r in table)
     holder = run_holder(store.path)
     running = bool(holder) and holder.get("campaign") in (name, None)

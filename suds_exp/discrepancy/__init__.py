@@ -2,12 +2,10 @@
 fit and test the simulator's named effects as candidates, name the one that significantly
 closes the held-out gap, add it and repeat."""
 
-from suds_exp.discrepancy.demo import demo_discrepancy, draw_hidden, hidden_effect_run
 from suds_exp.discrepancy.discover import Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, parse_effect_items
-from suds_exp.discrepancy.errors import DiscrepancyError
+from suds_exp.discrepancy.fit_candidates import FitSettings
 from suds_exp.discrepancy.replay import ReplaySettings
-from suds_exp.discrepancy.select import FitSettings
 from suds_exp.discrepancy.workflow import (
     DiscrepancyOptions,
     DiscrepancyResult,
@@ -15,6 +13,7 @@ from suds_exp.discrepancy.workflow import (
     parse_trial_ids,
     run_discrepancy,
 )
+from suds_exp.errors import DiscrepancyError
 
 __all__ = [
     "Candidate",
@@ -26,9 +25,6 @@ __all__ = [
     "FitSettings",
     "ReplaySettings",
     "candidates_for",
-    "demo_discrepancy",
-    "draw_hidden",
-    "hidden_effect_run",
     "parse_effect_items",
     "parse_exclude",
     "parse_trial_ids",

@@ -32,9 +32,9 @@ from scipy import stats
 from sklearn.linear_model import orthogonal_mp
 from sklearn.model_selection import GroupKFold
 
-from suds_exp.discrepancy.errors import DiscrepancyError
 from suds_exp.discrepancy.features import PHYSICS, Feature, channel_unit
-from suds_exp.discrepancy.select import trial_losses
+from suds_exp.discrepancy.fit_candidates import trial_losses
+from suds_exp.errors import DiscrepancyError
 
 
 @dataclass(frozen=True)
@@ -63,7 +63,7 @@ class DiscoverySettings:
 
     def __post_init__(self) -> None:
         if self.max_terms < 1:
-            raise DiscrepancyError(f"--max-terms {self.max_terms}: must be >= 1")
+            raise DiscrepancyError(f"max_terms {self.max_terms}: must be >= 1", param="max_terms")
 
 
 @dataclass

@@ -20,7 +20,8 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from suds_exp.errors import ConfigError
-from suds_exp.sim.config import SimConfig, config_from_dict
+from suds_exp.sim.config import SimConfig
+from suds_exp.sim.effects import apply_effects, set_effect
 
 #: For a choice-valued effect: which numeric parameter each choice brings along.
 CHOICE_COMPANIONS: dict[tuple[str, str], str] = {("flippers", "locked"): "locked_angle_deg"}
@@ -93,14 +94,9 @@ def effect_parameters(effect: str) -> list[dict]:
 
 
 def main_parameter(effect: str) -> dict:
-    """The main parameter of ``effect`` (the one ``--model-effect NAME=VALUE`` sets)."""
+    """The main parameter of ``effect`` (the one ``NAME=VALUE`` sets)."""
     params = effect_parameters(effect)
     return next((p for p in params if p["main"]), params[0])
-
-
-def set_effect(cfg: SimConfig, effect: str, settings: dict) -> SimConfig:
-    """A validated copy of ``cfg`` with ``settings`` ({param: value}) on ``effect``."""
-    return config_from_dict({"effects": {effect: dict(settings)}}, base=cfg)
 
 
 def get_effect(cfg: SimConfig, effect: str) -> dict:
@@ -109,40 +105,12 @@ def get_effect(cfg: SimConfig, effect: str) -> dict:
 
 
 def parse_effect_items(items: list[str], base: SimConfig | None = None) -> SimConfig:
-    """Apply ``["flippers=absent", "hinge_damping=8"]`` (main parameters) to ``base``.
+    """Apply ``["flippers=absent", "hinge_damping=8"]`` (main parameters; ``NAME.PARAM=VALUE``
+    for another) to ``base`` with the simulator's own parser (`sim.effects.parse_effect`).
 
-    ``NAME.PARAM=VALUE`` sets a parameter other than the main one. Raises `ConfigError`
-    naming the item when the effect, parameter or value is not valid.
+    Raises `ConfigError` naming the item when the effect, parameter or value is not valid.
     """
-    cfg = SimConfig() if base is None else base.copy()
-    for item in items:
-        key, sep, text = item.partition("=")
-        key, text = key.strip(), text.strip()
-        if not sep or not key or not text:
-            raise ConfigError(
-                f"--model-effect {item!r}: expected NAME=VALUE, e.g. --model-effect flippers=absent"
-            )
-        effect, _, param = key.partition(".")
-        names = {p["name"]: p for p in effect_parameters(effect)}
-        spec = names.get(param) if param else main_parameter(effect)
-        if spec is None:
-            raise ConfigError(
-                f"--model-effect {item!r}: effect {effect} has no parameter {param!r}; "
-                f"expected one of {', '.join(names)}"
-            )
-        value: object = text
-        if not isinstance(spec["nominal"], str):
-            try:
-                value = float(text)
-            except ValueError:
-                raise ConfigError(
-                    f"--model-effect {item!r}: expected a number for {effect}.{spec['name']}"
-                ) from None
-        try:
-            cfg = set_effect(cfg, effect, {spec["name"]: value})
-        except ConfigError as exc:
-            raise ConfigError(f"--model-effect {item!r}: {exc}") from None
-    return cfg
+    return apply_effects(SimConfig() if base is None else base.copy(), items, "model_effects")
 
 
 def _choices(spec: dict) -> list[str]:

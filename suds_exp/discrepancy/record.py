@@ -25,61 +25,9 @@ def _config_json(cfg) -> str:
 
 def record_run(store, result, options, started_at: _dt.datetime) -> int:
     """Insert ``result`` (a `DiscrepancyResult`) and return its run id."""
-    step_rows, cand_rows, loc_frames = [], [], []
-    for s in result.steps:
-        a = s.accepted
-        step_rows.append(
-            {
-                "step": s.index,
-                "model": _config_json(s.model),
-                "test_loss": float(s.test_loss),
-                "test_rmse_vx": float(s.test_rmse[0]),
-                "test_rmse_vy": float(s.test_rmse[1]),
-                "test_rmse_wz": float(s.test_rmse[2]),
-                "n_candidates": len(s.candidates),
-                "decision": s.decision,
-                "accepted": a.candidate.label if a else None,
-                "parameter": a.candidate.param if a else None,
-                "value": _num(a.value) if a else None,
-                "ci_low": _num(a.ci[0]) if a and a.ci else None,
-                "ci_high": _num(a.ci[1]) if a and a.ci else None,
-                "unit": a.candidate.unit if a else None,
-                "p_adjusted": _num(a.p_adjusted) if a else None,
-                "gap_closed": _num(s.gap_closed),
-                "systematic_z": _num(s.systematic[0]),
-                "systematic_p": _num(s.systematic[1]),
-                "correlations": None
-                if s.correlations is None
-                else json.dumps(s.correlations.head(20).values.tolist()),
-            }
-        )
-        for r in s.candidates:
-            cand_rows.append(
-                {
-                    "step": s.index,
-                    "candidate": r.candidate.label,
-                    "effect": r.candidate.effect,
-                    "parameter": r.candidate.param,
-                    "value": _num(r.value),
-                    "ci_low": _num(r.ci[0]) if r.ci else None,
-                    "ci_high": _num(r.ci[1]) if r.ci else None,
-                    "unit": r.candidate.unit,
-                    "train_loss_before": _num(r.train_before),
-                    "train_loss_after": _num(r.train_after),
-                    "test_loss_before": _num(np.mean(r.test_before)),
-                    "test_loss_after": _num(np.mean(r.test_after)),
-                    "improvement": _num(r.improvement),
-                    "p_value": _num(r.p_value),
-                    "p_adjusted": _num(r.p_adjusted),
-                    "significant": bool(r.significant),
-                    "accepted": bool(r.accepted),
-                    "n_replays": int(r.n_replays),
-                    "seconds": float(r.seconds),
-                }
-            )
-        loc = s.localisation.copy()
-        loc.insert(0, "step", s.index)
-        loc_frames.append(loc)
+    step_rows = [_step_row(s) for s in result.steps]
+    cand_rows = [_candidate_row(s.index, r) for s in result.steps for r in s.candidates]
+    loc_frames = [_with_step(s.localisation, s.index) for s in result.steps]
     with store.write() as conn:
         run_id = int(conn.execute(sa.text("SELECT nextval('discrepancy_runs_id_seq')")).scalar())
         conn.execute(
@@ -112,6 +60,63 @@ def record_run(store, result, options, started_at: _dt.datetime) -> int:
         store.insert_df(conn, "discrepancy_localisation", loc)
         _record_discoveries(store, conn, run_id, result)
     return run_id
+
+
+def _with_step(frame: pd.DataFrame, step: int) -> pd.DataFrame:
+    out = frame.copy()
+    out.insert(0, "step", step)
+    return out
+
+
+def _step_row(s) -> dict:
+    a = s.accepted
+    return {
+        "step": s.index,
+        "model": _config_json(s.model),
+        "test_loss": float(s.test_loss),
+        "test_rmse_vx": float(s.test_rmse[0]),
+        "test_rmse_vy": float(s.test_rmse[1]),
+        "test_rmse_wz": float(s.test_rmse[2]),
+        "n_candidates": len(s.candidates),
+        "decision": s.decision,
+        "accepted": a.candidate.label if a else None,
+        "parameter": a.candidate.param if a else None,
+        "value": _num(a.value) if a else None,
+        "ci_low": _num(a.ci[0]) if a and a.ci else None,
+        "ci_high": _num(a.ci[1]) if a and a.ci else None,
+        "unit": a.candidate.unit if a else None,
+        "p_adjusted": _num(a.p_adjusted) if a else None,
+        "gap_closed": _num(s.gap_closed),
+        "systematic_z": _num(s.systematic[0]),
+        "systematic_p": _num(s.systematic[1]),
+        "correlations": None
+        if s.correlations is None
+        else json.dumps(s.correlations.head(20).values.tolist()),
+    }
+
+
+def _candidate_row(step: int, r) -> dict:
+    return {
+        "step": step,
+        "candidate": r.candidate.label,
+        "effect": r.candidate.effect,
+        "parameter": r.candidate.param,
+        "value": _num(r.value),
+        "ci_low": _num(r.ci[0]) if r.ci else None,
+        "ci_high": _num(r.ci[1]) if r.ci else None,
+        "unit": r.candidate.unit,
+        "train_loss_before": _num(r.train_before),
+        "train_loss_after": _num(r.train_after),
+        "test_loss_before": _num(np.mean(r.test_before)),
+        "test_loss_after": _num(np.mean(r.test_after)),
+        "improvement": _num(r.improvement),
+        "p_value": _num(r.p_value),
+        "p_adjusted": _num(r.p_adjusted),
+        "significant": bool(r.significant),
+        "accepted": bool(r.accepted),
+        "n_replays": int(r.n_replays),
+        "seconds": float(r.seconds),
+    }
 
 
 def _record_discoveries(store, conn, run_id: int, result) -> None:

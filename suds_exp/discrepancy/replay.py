@@ -224,107 +224,138 @@ def make_windows(
     """
     s = settings or ReplaySettings()
     diff = differentiator or default_differentiator()
-    rows, per_group = [], {}
+    rows: list[dict] = []
+    per_group: dict[tuple, list] = {}
     for trial_id, tr in samples.sort_values(["trial_id", "t"]).groupby("trial_id", sort=True):
-        t = tr["t"].to_numpy(float)
-        if len(t) < 8:
-            continue
-        dt_cap = float(np.median(np.diff(t)))
-        freq = tr["frequency_hz"].iloc[0]
-        known = freq is not None and bool(np.isfinite(freq)) and freq > 0
-        if not known:
-            # a capture without a manifest: the gait frequency from its phase
-            ph = tr["phase"].to_numpy(float)
-            freq = (ph[-1] - ph[0]) / (2 * np.pi * max(t[-1] - t[0], 1e-9))
-            if not np.isfinite(freq) or freq <= 0:
-                continue
-        freq = float(freq)
-        period_frames = 1.0 / (freq * dt_cap)
-        step = max(1, int(round(period_frames / s.samples_per_cycle)))
-        if s.max_step_s > 0:
-            step = max(1, min(step, int(s.max_step_s / dt_cap + 1e-9)))
-        # the window the preprocessing used: from the frequency it knew, if any
-        sg = diff.window(1.0 / dt_cap, freq if known else None, len(t))
-        half = sg // 2
-        n_warm = int(round(s.warmup_cycles * period_frames / step)) * step
-        n_score = int(round(s.cycles_per_window * period_frames))
-        # the replay runs half a filter window past the scored end so the
-        # differentiator sees the same neighbourhood as the measurement's did
-        n_tail = int(np.ceil(half / step)) * step
-        n_total = n_warm + n_score + n_tail
-        n_total = int(np.ceil((n_total - 1) / step)) * step + 1
-        if len(t) < n_total:
-            continue
-        ra = tr[["ra_1", "ra_2"]].to_numpy(float)
-        ra_s = ra
-        if s.ra_smooth_s > 0:
-            w = min(_odd_window(s.ra_smooth_s, dt_cap, diff.polyorder), len(t) - 1 + len(t) % 2)
-            ra_s = savgol_filter(ra, w, diff.polyorder, axis=0)
-        meas = tr[list(CHANNELS)].to_numpy(float)
-        speed = np.hypot(meas[:, 0], meas[:, 1])
-        if pca is not None:
-            meas = np.column_stack(
-                [meas, tr[[f"rp_{i + 1}" for i in range(pca.n_components)]].to_numpy(float)]
-            )
-        # path length from the trial's start (mm -> m); before the first kept sample
-        # the robot is assumed to have moved at its mean speed
-        dist = (
-            np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))])
-            + np.nanmean(speed) * t[0]
-        ) / 1000.0
-        starts = np.linspace(0, len(t) - n_total, s.windows_per_trial + 2)[1:-1]
-        if s.windows_per_trial == 1:
-            starts = np.array([(len(t) - n_total) / 2])
-        key = (round(dt_cap * step, 9), step, n_total, n_warm, n_score, sg)
-        for a in np.round(starts).astype(int):
-            sc = slice(a + n_warm, a + n_warm + n_score)
-            g = per_group.setdefault(key, [])
-            g.append(
-                (
-                    len(rows),
-                    ra_s[a : a + n_total : step],
-                    meas[sc],
-                    tr["phase"].to_numpy(float)[sc],
-                    ra[sc],
-                    t[sc],
-                    dist[a],
-                    ra_s[a : a + n_total],
-                )
-            )
-            rows.append(
-                {
-                    "trial_id": int(trial_id),
-                    "gait": tr["gait"].iloc[0],
-                    "frequency_hz": freq,
-                    "t_start": float(t[a + n_warm]),
-                    "t_rel": float((t[sc][len(t[sc]) // 2] - t[0]) / max(t[-1] - t[0], 1e-9)),
-                }
-            )
-    groups = []
-    for (dt, step, n_total, n_warm, n_score, sg), items in per_group.items():
-        idx, phi, meas, phase, ra, tt, d0, ra_fine = zip(*items, strict=True)
-        meas = np.stack(meas)
-        if pca is not None:
-            meas[..., 3:] -= meas[..., 3:].mean(axis=1, keepdims=True)
-        groups.append(
-            WindowGroup(
-                dt=dt,
-                step=step,
-                index=np.array(idx),
-                phi=np.stack(phi),
-                measured=meas,
-                phase=np.stack(phase),
-                ra=np.stack(ra),
-                t=np.stack(tt),
-                d0=np.array(d0),
-                n_fine=n_total,
-                score_from=n_warm,
-                n_scored=n_score,
-                diff_frames=sg,
-                ra_fine=np.stack(ra_fine),
+        _cut_trial(int(trial_id), tr, s, diff, pca, rows, per_group)
+    groups = [_window_group(key, items, pca) for key, items in per_group.items()]
+    return WindowSet(pd.DataFrame(rows), groups, s, pca, diff)
+
+
+def _trial_frequency(tr: pd.DataFrame, t: np.ndarray) -> tuple[float, bool] | None:
+    """The trial's gait frequency (Hz) and whether the manifest gave it (else from its
+    phase); None when neither gives a positive one."""
+    freq = tr["frequency_hz"].iloc[0]
+    known = freq is not None and bool(np.isfinite(freq)) and freq > 0
+    if not known:
+        # a capture without a manifest: the gait frequency from its phase
+        ph = tr["phase"].to_numpy(float)
+        freq = (ph[-1] - ph[0]) / (2 * np.pi * max(t[-1] - t[0], 1e-9))
+        if not np.isfinite(freq) or freq <= 0:
+            return None
+    return float(freq), known
+
+
+def _window_frames(s: ReplaySettings, diff: Differentiator, freq, known, dt_cap, n):
+    """(step, differentiator window, warm-up, scored and total frames) of a window."""
+    period_frames = 1.0 / (freq * dt_cap)
+    step = max(1, int(round(period_frames / s.samples_per_cycle)))
+    if s.max_step_s > 0:
+        step = max(1, min(step, int(s.max_step_s / dt_cap + 1e-9)))
+    # the window the preprocessing used: from the frequency it knew, if any
+    sg = diff.window(1.0 / dt_cap, freq if known else None, n)
+    half = sg // 2
+    n_warm = int(round(s.warmup_cycles * period_frames / step)) * step
+    n_score = int(round(s.cycles_per_window * period_frames))
+    # the replay runs half a filter window past the scored end so the
+    # differentiator sees the same neighbourhood as the measurement's did
+    n_tail = int(np.ceil(half / step)) * step
+    n_total = n_warm + n_score + n_tail
+    n_total = int(np.ceil((n_total - 1) / step)) * step + 1
+    return step, sg, n_warm, n_score, n_total
+
+
+def _trial_signals(tr: pd.DataFrame, t, s: ReplaySettings, diff: Differentiator, pca, dt_cap):
+    """r_a (rad) as measured and as driven (smoothed), the compared channels and the path
+    length from the trial's start (m)."""
+    ra = tr[["ra_1", "ra_2"]].to_numpy(float)
+    ra_s = ra
+    if s.ra_smooth_s > 0:
+        w = min(_odd_window(s.ra_smooth_s, dt_cap, diff.polyorder), len(t) - 1 + len(t) % 2)
+        ra_s = savgol_filter(ra, w, diff.polyorder, axis=0)
+    meas = tr[list(CHANNELS)].to_numpy(float)
+    speed = np.hypot(meas[:, 0], meas[:, 1])
+    if pca is not None:
+        meas = np.column_stack(
+            [meas, tr[[f"rp_{i + 1}" for i in range(pca.n_components)]].to_numpy(float)]
+        )
+    # path length from the trial's start (mm -> m); before the first kept sample
+    # the robot is assumed to have moved at its mean speed
+    dist = (
+        np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))])
+        + np.nanmean(speed) * t[0]
+    ) / 1000.0
+    return ra, ra_s, meas, dist
+
+
+def _cut_trial(trial_id, tr, s: ReplaySettings, diff, pca, rows: list, per_group: dict):
+    """Append the windows of one trial: their info rows to ``rows``, their arrays to
+    ``per_group`` under the key of their shape."""
+    t = tr["t"].to_numpy(float)
+    if len(t) < 8:
+        return
+    dt_cap = float(np.median(np.diff(t)))
+    found = _trial_frequency(tr, t)
+    if found is None:
+        return
+    freq, known = found
+    step, sg, n_warm, n_score, n_total = _window_frames(s, diff, freq, known, dt_cap, len(t))
+    if len(t) < n_total:
+        return
+    ra, ra_s, meas, dist = _trial_signals(tr, t, s, diff, pca, dt_cap)
+    starts = np.linspace(0, len(t) - n_total, s.windows_per_trial + 2)[1:-1]
+    if s.windows_per_trial == 1:
+        starts = np.array([(len(t) - n_total) / 2])
+    key = (round(dt_cap * step, 9), step, n_total, n_warm, n_score, sg)
+    for a in np.round(starts).astype(int):
+        sc = slice(a + n_warm, a + n_warm + n_score)
+        g = per_group.setdefault(key, [])
+        g.append(
+            (
+                len(rows),
+                ra_s[a : a + n_total : step],
+                meas[sc],
+                tr["phase"].to_numpy(float)[sc],
+                ra[sc],
+                t[sc],
+                dist[a],
+                ra_s[a : a + n_total],
             )
         )
-    return WindowSet(pd.DataFrame(rows), groups, s, pca, diff)
+        rows.append(
+            {
+                "trial_id": trial_id,
+                "gait": tr["gait"].iloc[0],
+                "frequency_hz": freq,
+                "t_start": float(t[a + n_warm]),
+                "t_rel": float((t[sc][len(t[sc]) // 2] - t[0]) / max(t[-1] - t[0], 1e-9)),
+            }
+        )
+
+
+def _window_group(key: tuple, items: list, pca) -> WindowGroup:
+    """The windows of one shape (``key``) stacked into a `WindowGroup`."""
+    dt, step, n_total, n_warm, n_score, sg = key
+    idx, phi, meas, phase, ra, tt, d0, ra_fine = zip(*items, strict=True)
+    meas = np.stack(meas)
+    if pca is not None:
+        meas[..., 3:] -= meas[..., 3:].mean(axis=1, keepdims=True)
+    return WindowGroup(
+        dt=dt,
+        step=step,
+        index=np.array(idx),
+        phi=np.stack(phi),
+        measured=meas,
+        phase=np.stack(phase),
+        ra=np.stack(ra),
+        t=np.stack(tt),
+        d0=np.array(d0),
+        n_fine=n_total,
+        score_from=n_warm,
+        n_scored=n_score,
+        diff_frames=sg,
+        ra_fine=np.stack(ra_fine),
+    )
 
 
 def _window_config(cfg: SimConfig, d0_m: float, tol: float) -> SimConfig:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -19,7 +19,14 @@ import pandas as pd
 
 from suds_exp.discrepancy.discover import Discovery, DiscoverySettings, discover
 from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
-from suds_exp.discrepancy.errors import DiscrepancyError
+from suds_exp.discrepancy.fit_candidates import (
+    CandidateResult,
+    FitSettings,
+    fit_candidate,
+    refine_candidate,
+    score_candidates,
+    trial_losses,
+)
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
 from suds_exp.discrepancy.replay import (
     ReplaySettings,
@@ -30,16 +37,10 @@ from suds_exp.discrepancy.replay import (
     settings_from_prep,
     window_field,
 )
-from suds_exp.discrepancy.select import (
-    CandidateResult,
-    FitSettings,
-    fit_candidate,
-    refine_candidate,
-    score_candidates,
-    trial_losses,
-)
+from suds_exp.errors import DiscrepancyError
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.version import get_version
+from suds_exp.progress import progress_lines
 from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 from suds_exp.sim.config import SimConfig
 
@@ -71,7 +72,7 @@ class DiscrepancyOptions:
         a residual of about 10% of the signal) below which a remaining gap is called
         negligible even when it is statistically systematic.
     exclude : tuple of str
-        Effects never offered as candidates (``--exclude-candidates``): the withheld-effect
+        Effects never offered as candidates: the withheld-effect
         checks hide an effect in the data and exclude it here.
     discover : bool
         When no candidate is significant and a systematic gap above ``gap_floor``
@@ -96,8 +97,9 @@ class DiscrepancyOptions:
         self.exclude = parse_exclude(",".join(self.exclude))
         if not self.discover and set(effect_names()) <= set(self.exclude):
             raise DiscrepancyError(
-                "--exclude-candidates: every candidate is excluded and discovery is off; "
-                "nothing could explain the gap"
+                "exclude: every candidate is excluded and discovery is off; "
+                "nothing could explain the gap",
+                param="exclude",
             )
 
     def to_dict(self) -> dict:
@@ -278,7 +280,8 @@ def parse_exclude(text: str | None) -> tuple[str, ...]:
     for x in out:
         if x not in names:
             raise DiscrepancyError(
-                f"--exclude-candidates {x!r}: unknown effect; expected one of {', '.join(names)}"
+                f"exclude {x!r}: unknown effect; expected one of {', '.join(names)}",
+                param="exclude",
             )
     return out
 
@@ -360,6 +363,293 @@ def _discover(full, samples, sim, meas, scales, train_ids, opts, rng) -> Discove
     )
 
 
+@dataclass
+class Loaded:
+    """The samples a run compares with and what their preprocessing version says about
+    them: its name and parameters, its passive PCA (None: r_p not compared) and its
+    differentiator (None: the default parameters')."""
+
+    samples: pd.DataFrame
+    prep_name: str | None = None
+    prep_params: dict = field(default_factory=dict)
+    pca: object | None = None
+    differentiator: Differentiator | None = None
+
+
+@dataclass
+class Windows:
+    """The replay windows of a run and its trial split.
+
+    ``coarse``: the decimated windows candidates are fitted and scored on, ``train`` and
+    ``test`` its halves; ``full``: the same windows at the capture rate, where the gap is
+    measured, with ``measured`` (window, frame, channel), ``is_test`` (window,) and the
+    per-channel ``scales`` of the residual.
+    """
+
+    samples: pd.DataFrame
+    coarse: WindowSet
+    full: WindowSet
+    train: WindowSet
+    test: WindowSet
+    train_ids: list[int]
+    test_ids: list[int]
+    scales: np.ndarray
+    measured: np.ndarray
+    is_test: np.ndarray
+    phase: np.ndarray
+    ra: np.ndarray
+    t: np.ndarray
+
+
+def check_options(opts: DiscrepancyOptions) -> None:
+    """Raise `DiscrepancyError` for an ``alpha`` outside (0, 1) or a negative
+    ``max_effects``."""
+    if not 0 < opts.alpha < 1:
+        raise DiscrepancyError(f"alpha {opts.alpha}: must be between 0 and 1", param="alpha")
+    if opts.max_effects < 0:
+        raise DiscrepancyError(f"max_effects {opts.max_effects}: must be >= 0", param="max_effects")
+
+
+def load(
+    store=None,
+    prep: str | int | None = None,
+    trials: Iterable[int] | None = None,
+    samples: pd.DataFrame | None = None,
+    passive: bool = True,
+) -> Loaded:
+    """The samples to replay: ``samples`` if given (only ``trials``), else those of
+    version ``prep`` in ``store``; its PCA only with ``passive``."""
+    if samples is None:
+        if store is None:
+            raise DiscrepancyError("run_discrepancy: give a store or a samples frame")
+        version = get_version(store, prep)
+        loaded = Loaded(
+            version.samples(trials),
+            version.name,
+            version.params,
+            version.pca if passive else None,
+            version.differentiator(),
+        )
+    else:
+        if trials is not None:
+            samples = samples[samples["trial_id"].isin(list(trials))]
+        loaded = Loaded(samples)
+    if loaded.samples.empty:
+        raise DiscrepancyError(
+            "no samples to replay: check trials and prep", param=("trials", "prep")
+        )
+    return loaded
+
+
+def cut_windows(loaded: Loaded, rs: ReplaySettings, rng: np.random.Generator) -> Windows:
+    """Cut the replay windows (decimated and at the capture rate) and split the trials."""
+    samples, pca, differ = loaded.samples, loaded.pca, loaded.differentiator
+    coarse = make_windows(samples, rs, pca, differ)
+    if len(coarse.info) == 0:
+        raise DiscrepancyError(
+            "every trial is shorter than one replay window "
+            f"({rs.warmup_cycles + rs.cycles_per_window} cycles)"
+        )
+    train_ids, test_ids = split_trials(coarse.info, rng)
+    if len(train_ids) < 2 or len(test_ids) < 2:
+        raise DiscrepancyError(
+            f"need at least 4 trials long enough to replay, have {len(train_ids) + len(test_ids)}"
+        )
+    # the gap itself (and the parameter refinement) is measured without decimation: the
+    # decimated replay's own error would otherwise look like a systematic gap
+    full = make_windows(
+        samples[samples["trial_id"].isin(coarse.trial_id)], _full_rate(rs), pca, differ
+    )
+    phase, ra, t = (window_field(full, f) for f in ("phase", "ra", "t"))
+    return Windows(
+        samples=samples,
+        coarse=coarse,
+        full=full,
+        train=coarse.subset(train_ids),
+        test=coarse.subset(test_ids),
+        train_ids=train_ids,
+        test_ids=test_ids,
+        scales=_scales(measured(coarse)),
+        measured=measured(full),
+        is_test=np.isin(full.trial_id, test_ids),
+        phase=phase,
+        ra=ra,
+        t=t,
+    )
+
+
+def gap_step(w: Windows, model: SimConfig, index: int, rng: np.random.Generator):
+    """Replay ``model`` over every window at the capture rate: the `Step` with its
+    held-out gap and localisation, and the replay (window, frame, channel)."""
+    sim = replay(w.full, [model])[0]
+    residual = (sim - w.measured)[..., :3]
+    is_test = w.is_test
+    _, tl = trial_losses(
+        sim[None, is_test], w.measured[is_test], w.scales, w.full.trial_id[is_test]
+    )
+    k = int(np.flatnonzero(is_test)[0])
+    step = Step(
+        index=index,
+        model=model,
+        test_loss=float(tl[0].mean()),
+        test_rmse=_rmse(sim[is_test, :, :3], w.measured[is_test, :, :3]),
+        test_trial_loss=tl[0],
+        localisation=localise(w.full.info, residual, w.phase, w.ra, rng),
+        example={
+            "trial_id": int(w.full.trial_id[k]),
+            "t": w.t[k],
+            "measured": w.measured[k, :, :3],
+            "simulated": sim[k, :, :3],
+        },
+    )
+    return step, sim
+
+
+def try_candidates(
+    step: Step, w: Windows, opts: DiscrepancyOptions, exclude: set[str], rng, say
+) -> None:
+    """Fit every observable candidate on the training half and score it held-out, into
+    ``step.candidates`` (the unobservable ones into ``step.unobservable``)."""
+    current = step.model
+    probe = w.train.subset(w.train_ids[:1])
+    cands = []
+    for c in candidates_for(current, exclude=exclude | set(opts.exclude)):
+        if _observable(c, current, probe):
+            cands.append(c)
+        else:
+            step.unobservable.append(c.label)
+    for c in cands:
+        r = fit_candidate(c, current, w.train, w.scales, opts.fit, rng)
+        step.candidates.append(r)
+        say(f"  fitted {c.label}: {r.value} in {r.seconds:.1f} s")
+    if step.candidates:
+        score_candidates(step.candidates, current, w.test, w.scales, opts.alpha, opts.fit)
+        _, base_train = trial_losses(
+            replay(w.train, [current]), measured(w.train), w.scales, w.train.trial_id
+        )
+        for r in step.candidates:
+            r.train_before = float(base_train[0].mean())
+
+
+def explain_gap(step: Step, w: Windows, sim: np.ndarray, opts: DiscrepancyOptions, rng, say):
+    """No candidate is significant: test whether the gap is systematic and, if it is and
+    above ``gap_floor``, correlate it with the signals and try a learned correction."""
+    step.decision = "none_significant"
+    residual = (sim - w.measured)[..., :3]
+    # systematic = the residual's phase profile repeats across independent halves
+    step.systematic = systematic_gap(residual, w.phase, w.full.info, (w.train_ids, w.test_ids))
+    if step.systematic[1] >= opts.alpha or step.test_loss <= opts.gap_floor:
+        return
+    step.correlations = residual_correlations(
+        w.samples,
+        residual[w.is_test],
+        w.t[w.is_test],
+        w.full.info[w.is_test].reset_index(drop=True),
+    )
+    if not opts.discover:
+        return
+    step.discovery = d = _discover(
+        w.full, w.samples, sim, w.measured, w.scales, w.train_ids, opts, rng
+    )
+    say(
+        f"  discovered correction ({'added' if d.significant else 'not added'}, "
+        f"p {d.p_value:.2g}): held-out loss {np.mean(d.test_before):.4g} -> "
+        f"{np.mean(d.test_after):.4g}; leading {', '.join(d.leading[:3])}"
+    )
+    if d.significant:
+        step.decision = "discovered"
+
+
+def accept(
+    step: Step, best: CandidateResult, earlier: list[Step], w: Windows, opts, rng, say
+) -> SimConfig:
+    """Name ``best`` at ``step`` (refined at the capture rate with ``opts.refine``, and the
+    ``earlier`` steps' effects re-fitted with it); returns the model with it added."""
+    current = step.model
+    train_full = w.full.subset(w.train_ids)
+    if opts.refine and best.candidate.param is not None:
+        refine_candidate(best, current, train_full, w.scales, opts.fit, rng)
+        say(f"  refined {best.candidate.label} at the capture rate: {best.value:.4g} {best.ci}")
+    best.accepted = True
+    step.accepted = best
+    step.decision = "accepted"
+    current = best.config
+    say(
+        f"  named {best.candidate.label} (p_adj {best.p_adjusted:.2g}, "
+        f"held-out improvement {best.improvement:.0%})"
+    )
+    if opts.refine:
+        # effects named earlier were fitted without this one: re-fit each once with
+        # the others in the model (one pass of coordinate descent), so the reported
+        # values and intervals belong to the final model
+        for s in earlier:
+            r = s.accepted
+            if r is None or r.candidate.param is None:
+                continue
+            refine_candidate(r, current, train_full, w.scales, opts.fit, rng)
+            current = r.config
+            say(f"  re-fitted {r.candidate.label}: {r.value:.4g} {r.ci}")
+    return current
+
+
+def outcome(steps: list[Step]) -> str:
+    """One sentence on what the run found (the last step's decision and the names)."""
+    last = steps[-1]
+    named = [s.accepted.candidate.label for s in steps if s.accepted]
+    d = last.discovery
+    if d is not None and d.significant:
+        return (
+            ("named " + ", ".join(named) + "; then " if named else "")
+            + "a systematic gap no candidate explains; learned correction "
+            f"({d.physics or 'no term'}: {', '.join(d.leading[:3])}) closes "
+            f"{d.improvement:.0%} of the held-out gap"
+        )
+    if last.correlations is not None:
+        top = last.correlations.head(3)
+        return (
+            "a systematic gap remains that no candidate explains; residual correlates most with "
+            + ", ".join(f"{r.signal} ({r.channel}, r={r.r:+.2f})" for r in top.itertuples())
+        )
+    if named:
+        return "named " + ", ".join(named)
+    return "nothing named: no candidate improves the held-out fit significantly"
+
+
+def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
+    """The loop: replay, try the candidates, name the best significant one, repeat, until
+    none is significant or ``opts.max_effects`` are named. Returns the steps and the
+    final model."""
+    steps: list[Step] = []
+    current = model
+    for index in range(opts.max_effects + 1):
+        step, sim = gap_step(w, current, index, rng)
+        if steps:
+            prev = steps[-1]
+            prev.gap_closed = 1.0 - step.test_loss / prev.test_loss if prev.test_loss > 0 else 0.0
+        steps.append(step)
+        say(
+            f"step {index}: held-out loss {step.test_loss:.4g}, "
+            f"rmse vx {step.test_rmse[0]:.3g} mm/s"
+        )
+        named = {s.accepted.candidate.effect for s in steps if s.accepted}
+        if len(named) >= opts.max_effects:
+            step.decision = "max_effects"
+            break
+        try_candidates(step, w, opts, named, rng, say)
+        significant = [r for r in step.candidates if r.significant]
+        if not significant:
+            explain_gap(step, w, sim, opts, rng, say)
+            break
+        best = max(significant, key=lambda r: r.improvement)
+        current = accept(step, best, steps[:-1], w, opts, rng, say)
+    return steps, current
+
+
+def default_name(when: _dt.datetime | None = None) -> str:
+    """A run's default name, ``discrepancy-<YYYYmmdd-HHMMSS>`` of ``when`` (default: now)."""
+    return f"discrepancy-{(when or _dt.datetime.now()):%Y%m%d-%H%M%S}"
+
+
 def run_discrepancy(
     store=None,
     prep: str | int | None = None,
@@ -369,8 +659,7 @@ def run_discrepancy(
     options: DiscrepancyOptions | None = None,
     out: str | Path | None = None,
     samples: pd.DataFrame | None = None,
-    log: Callable[[str], None] | None = None,
-    default_out: Path | None = None,
+    progress: bool = False,
 ) -> DiscrepancyResult:
     """Find, name and fix what ``model`` misses about the measured trials.
 
@@ -389,211 +678,45 @@ def run_discrepancy(
         Only these trial ids.
     options : DiscrepancyOptions, optional
     out : path, optional
-        Report folder (index.html, PNG figures, Markdown/CSV tables); None: no report,
-        unless ``default_out`` is given (then ``default_out / name``).
+        Report folder (index.html, PNG figures, Markdown/CSV tables); None: no report.
     samples : DataFrame, optional
         A samples frame to use instead of loading one from the store; its rates are
         taken to come from the default preprocessing parameters' differentiator.
-    log : callable, optional
-        Receives one line per stage (progress).
+    progress : bool
+        Print one line per stage on stderr.
 
     Returns
     -------
     DiscrepancyResult
     """
-    started = time.perf_counter()
-    cpu_started = time.process_time()
+    started, cpu_started = time.perf_counter(), time.process_time()
     started_at = _dt.datetime.now()
     opts = options or DiscrepancyOptions()
-    if not 0 < opts.alpha < 1:
-        raise DiscrepancyError(f"--alpha {opts.alpha}: must be between 0 and 1")
-    if opts.max_effects < 0:
-        raise DiscrepancyError(f"--max-effects {opts.max_effects}: must be >= 0")
-    say = log or (lambda _msg: None)
-    prep_name, prep_params, pca, differ = None, {}, None, None
-    if samples is None:
-        if store is None:
-            raise DiscrepancyError("run_discrepancy: give a store or a samples frame")
-        version = get_version(store, prep)
-        prep_name, prep_params = version.name, version.params
-        samples, differ = version.samples(trials), version.differentiator()
-        if opts.passive:
-            pca = version.pca
-    elif trials is not None:
-        samples = samples[samples["trial_id"].isin(list(trials))]
-    if samples.empty:
-        raise DiscrepancyError("no samples to replay: check --trials and --prep")
-    rs = opts.replay or settings_from_prep(prep_params)
+    check_options(opts)
+    say = progress_lines(progress)
+    loaded = load(store, prep, trials, samples, opts.passive)
     model = model or SimConfig()
-    name = name or f"discrepancy-{started_at:%Y%m%d-%H%M%S}"
-    if out is None and default_out is not None:
-        out = Path(default_out) / (
-            name if name.startswith("discrepancy") else f"discrepancy-{name}"
-        )
+    name = name or default_name(started_at)
     rng = np.random.default_rng(opts.seed)
-
-    windows = make_windows(samples, rs, pca, differ)
-    if len(windows.info) == 0:
-        raise DiscrepancyError(
-            "every trial is shorter than one replay window "
-            f"({rs.warmup_cycles + rs.cycles_per_window} cycles)"
-        )
-    train_ids, test_ids = split_trials(windows.info, rng)
-    if len(train_ids) < 2 or len(test_ids) < 2:
-        raise DiscrepancyError(
-            f"need at least 4 trials long enough to replay, have {len(train_ids) + len(test_ids)}"
-        )
-    train, test = windows.subset(train_ids), windows.subset(test_ids)
-    coarse_meas = measured(windows)
-    scales = _scales(coarse_meas)
-    # the gap itself (and the parameter refinement) is measured without decimation: the
-    # decimated replay's own error would otherwise look like a systematic gap
-    full = make_windows(
-        samples[samples["trial_id"].isin(windows.trial_id)], _full_rate(rs), pca, differ
-    )
-    meas_all = measured(full)
-    is_test = np.isin(full.trial_id, test_ids)
-    phase_all, ra_all, t_all = (window_field(full, f) for f in ("phase", "ra", "t"))
+    w = cut_windows(loaded, opts.replay or settings_from_prep(loaded.prep_params), rng)
     say(
-        f"{len(windows.info)} windows over {len(train_ids)} training and "
-        f"{len(test_ids)} held-out trials"
+        f"{len(w.coarse.info)} windows over {len(w.train_ids)} training and "
+        f"{len(w.test_ids)} held-out trials"
     )
-
-    steps: list[Step] = []
-    accepted_effects: set[str] = set()
-    current = model
-    example_k = int(np.flatnonzero(is_test)[0])
-    for index in range(opts.max_effects + 1):
-        sim = replay(full, [current])[0]
-        residual = (sim - meas_all)[..., :3]
-        _, tl = trial_losses(sim[None, is_test], meas_all[is_test], scales, full.trial_id[is_test])
-        step = Step(
-            index=index,
-            model=current,
-            test_loss=float(tl[0].mean()),
-            test_rmse=_rmse(sim[is_test, :, :3], meas_all[is_test, :, :3]),
-            test_trial_loss=tl[0],
-            localisation=localise(full.info, residual, phase_all, ra_all, rng),
-            example={
-                "trial_id": int(full.trial_id[example_k]),
-                "t": t_all[example_k],
-                "measured": meas_all[example_k, :, :3],
-                "simulated": sim[example_k, :, :3],
-            },
-        )
-        if steps:
-            prev = steps[-1]
-            prev.gap_closed = 1.0 - step.test_loss / prev.test_loss if prev.test_loss > 0 else 0.0
-        steps.append(step)
-        say(
-            f"step {index}: held-out loss {step.test_loss:.4g}, "
-            f"rmse vx {step.test_rmse[0]:.3g} mm/s"
-        )
-        if len(accepted_effects) >= opts.max_effects:
-            step.decision = "max_effects"
-            break
-        offered = candidates_for(current, exclude=accepted_effects | set(opts.exclude))
-        probe = train.subset(train_ids[:1])
-        cands = []
-        for c in offered:
-            if _observable(c, current, probe):
-                cands.append(c)
-            else:
-                step.unobservable.append(c.label)
-        for c in cands:
-            r = fit_candidate(c, current, train, scales, opts.fit, rng)
-            step.candidates.append(r)
-            say(f"  fitted {c.label}: {r.value} in {r.seconds:.1f} s")
-        if step.candidates:
-            score_candidates(step.candidates, current, test, scales, opts.alpha, opts.fit)
-            _, base_train = trial_losses(
-                replay(train, [current]), measured(train), scales, train.trial_id
-            )
-            for r in step.candidates:
-                r.train_before = float(base_train[0].mean())
-        significant = [r for r in step.candidates if r.significant]
-        if not significant:
-            step.decision = "none_significant"
-            # systematic = the residual's phase profile repeats across independent halves
-            step.systematic = systematic_gap(residual, phase_all, full.info, (train_ids, test_ids))
-            if step.systematic[1] < opts.alpha and step.test_loss > opts.gap_floor:
-                step.correlations = residual_correlations(
-                    samples,
-                    residual[is_test],
-                    t_all[is_test],
-                    full.info[is_test].reset_index(drop=True),
-                )
-                if opts.discover:
-                    step.discovery = _discover(
-                        full, samples, sim, meas_all, scales, train_ids, opts, rng
-                    )
-                    d = step.discovery
-                    say(
-                        f"  discovered correction ({'added' if d.significant else 'not added'}, "
-                        f"p {d.p_value:.2g}): held-out loss {np.mean(d.test_before):.4g} -> "
-                        f"{np.mean(d.test_after):.4g}; leading {', '.join(d.leading[:3])}"
-                    )
-                    if d.significant:
-                        step.decision = "discovered"
-            break
-        best = max(significant, key=lambda r: r.improvement)
-        if opts.refine and best.candidate.param is not None:
-            refine_candidate(best, current, full.subset(train_ids), scales, opts.fit, rng)
-            say(f"  refined {best.candidate.label} at the capture rate: {best.value:.4g} {best.ci}")
-        best.accepted = True
-        step.accepted = best
-        step.decision = "accepted"
-        accepted_effects.add(best.candidate.effect)
-        current = best.config
-        say(
-            f"  named {best.candidate.label} (p_adj {best.p_adjusted:.2g}, "
-            f"held-out improvement {best.improvement:.0%})"
-        )
-        if opts.refine:
-            # effects named earlier were fitted without this one: re-fit each once with
-            # the others in the model (one pass of coordinate descent), so the reported
-            # values and intervals belong to the final model
-            for earlier in steps[:-1]:
-                r = earlier.accepted
-                if r is None or r.candidate.param is None:
-                    continue
-                refine_candidate(r, current, full.subset(train_ids), scales, opts.fit, rng)
-                current = r.config
-                say(f"  re-fitted {r.candidate.label}: {r.value:.4g} {r.ci}")
-
-    last = steps[-1]
-    named = [s.accepted.candidate.label for s in steps if s.accepted]
-    d = last.discovery
-    if d is not None and d.significant:
-        outcome = (
-            ("named " + ", ".join(named) + "; then " if named else "")
-            + "a systematic gap no candidate explains; learned correction "
-            f"({d.physics or 'no term'}: {', '.join(d.leading[:3])}) closes "
-            f"{d.improvement:.0%} of the held-out gap"
-        )
-    elif last.correlations is not None:
-        top = last.correlations.head(3)
-        outcome = (
-            "a systematic gap remains that no candidate explains; residual correlates most with "
-            + ", ".join(f"{r.signal} ({r.channel}, r={r.r:+.2f})" for r in top.itertuples())
-        )
-    elif named:
-        outcome = "named " + ", ".join(named)
-    else:
-        outcome = "nothing named: no candidate improves the held-out fit significantly"
+    steps, current = run_steps(w, model, opts, rng, say)
     result = DiscrepancyResult(
         run_id=None,
         name=name,
-        prep_version=prep_name,
+        prep_version=loaded.prep_name,
         steps=steps,
-        train_trials=train_ids,
-        test_trials=test_ids,
+        train_trials=w.train_ids,
+        test_trials=w.test_ids,
         start_model=model,
         final_model=current,
-        outcome=outcome,
+        outcome=outcome(steps),
         seconds=time.perf_counter() - started,
         cpu_seconds=time.process_time() - cpu_started,
-        differentiator=windows.differentiator,
+        differentiator=w.coarse.differentiator,
     )
     if out is not None:
         from suds_exp.discrepancy.report import write_report

@@ -166,7 +166,9 @@ def ingest_paths(
     exclude = {Path(p).resolve() for p in (manifest, layout) if p is not None}
     files = expand_paths(list(paths), exclude) if paths else sorted(conditions)
     if not files:
-        raise IngestError("nothing to ingest: give capture files, folders or --manifest")
+        raise IngestError(
+            "nothing to ingest: give capture files, folders or manifest", param="manifest"
+        )
     results = []
     source = str(layout) if layout else "layout"
     enabled = progress and len(files) > 1

@@ -5,8 +5,8 @@
 | `phase-only` | `phase_only.PhaseOnly`         | v_b(phase), Fourier series               |
 | `TLS`        | `tls.TLS`                      | phase-binned TLS of v_b on r_a offsets   |
 | `TLS+SUDS`   | `tls.TLSSuds`                  | the same on (r_a, r_p) + dr_p/dt         |
-| `GMR`        | `agbr.GMR`                     | A-GBR of v_b on (r_a, dr_a/dt)           |
-| `GMR+SUDS`   | `agbr.GMRSuds`                 | A-GBR of (v_b, dr_p/dt) on (r_a, r_p, dr_a/dt) |
+| `GMR`        | `gmr.GMR`                      | A-GBR of v_b on (r_a, dr_a/dt)           |
+| `GMR+SUDS`   | `gmr.GMRSuds`                  | A-GBR of (v_b, dr_p/dt) on (r_a, r_p, dr_a/dt) |
 
 Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(samples)`:
 `OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
@@ -23,8 +23,8 @@ Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 from __future__ import annotations
 
 from suds_exp.errors import ConfigError
-from suds_exp.models.agbr import GMR, GMRSuds
 from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly

@@ -17,16 +17,12 @@ import numpy as np
 import pandas as pd
 from sklearn.base import BaseEstimator
 
-from suds_exp.errors import ConfigError, SudsError
+from suds_exp.errors import ConfigError, ModelError
 from suds_exp.robot import DRA_COLUMNS, RA_COLUMNS, VB_COLUMNS  # noqa: F401  (also imported from here)
 
 _RP_PATTERN = re.compile(r"^rp_(\d+)$")
 _RA_PATTERN = re.compile(r"^ra_(\d+)$")
 GAP_FACTOR = 5.0
-
-
-class ModelError(SudsError):
-    """A samples frame cannot be used by a learner as given (missing column, too few rows)."""
 
 
 def _consecutive(samples: pd.DataFrame, pattern: re.Pattern) -> int:

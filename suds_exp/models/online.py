@@ -1,8 +1,8 @@
 """Online GMR and GMR+SUDS: A-GBR whose mixture follows a stream of samples.
 
 The Future Work of the paper asks for "an online version of GMR or GMR+SUDS" for a robot
-whose world changes. `OnlineGMR` and `OnlineGMRSuds` keep the regression of `agbr.GMR` /
-`agbr.GMRSuds` (same inputs, outputs, homogeneous augmentation, predictions, rollout) and
+whose world changes. `OnlineGMR` and `OnlineGMRSuds` keep the regression of `gmr.GMR` /
+`gmr.GMRSuds` (same inputs, outputs, homogeneous augmentation, predictions, rollout) and
 replace the batch EM by stepwise EM on per-component sufficient statistics
 (Neal & Hinton 1998; Cappe & Moulines 2009, "Online EM algorithm for latent data models"):
 
@@ -40,7 +40,6 @@ import pandas as pd
 from scipy.special import logsumexp
 
 from suds_exp.errors import ConfigError
-from suds_exp.models.agbr import GMR, GMRSuds
 from suds_exp.models.base import (
     ModelError,
     actuated_columns,
@@ -51,6 +50,7 @@ from suds_exp.models.base import (
     require_columns,
     rollout_bounds,
 )
+from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.mixture import Conditional, fit_mixture, log_gaussians
 
 

@@ -5,7 +5,7 @@ or with `suds=True` those of GMR+SUDS, (r_a, r_p, dr_a/dt) -> (v_b, dr_p/dt), wi
 rollout of r_p as GMR+SUDS does it (explicit Euler from each trial's first measured r_p,
 clipped to the training range widened by a tenth of its width).
 
-`homogeneous=True` is A-GBR's change of variables (see `agbr.py`): with
+`homogeneous=True` is A-GBR's change of variables (see `gmr.py`): with
 rho = sqrt(|dr_a/dt|^2 + f0^2) (f0 = `speed_floor` x the training median |dr_a/dt|) the
 estimator learns (v_b, dr_p/dt) / rho from (r_a[, r_p], dr_a/dt / rho) and predictions
 are multiplied back by rho, so any regressor becomes exactly rate-independent.

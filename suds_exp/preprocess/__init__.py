@@ -1,7 +1,7 @@
 """Preprocessing: markers -> samples (cleaning, body frame, shape, PCA, Phaser, rates),
 stored as named, versioned parameter sets."""
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.params import (
     DEFAULTS,
     PRESETS,

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 
 #: At most this many frames feed the nonlinear joint refinement (the linear start uses all).
 JOINT_FIT_FRAMES = 4000

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import median_filter
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 
 #: Steps in the running median that gives a marker's expected motion per frame.
 MEDIAN_STEPS = 7
@@ -224,7 +224,8 @@ def clean_tracks(
             raise PreprocessError(
                 f"marker {names[m]} has a gap of {runs[worst]} frames starting at frame "
                 f"index {edges[worst] + 1}, longer than the {max_gap_frames} frames allowed "
-                "(raise --param max_gap_s or leave the trial out)"
+                "(raise params max_gap_s or leave the trial out)",
+                param="params",
             )
         for c in range(3):
             out[:, m, c] = np.interp(frames, keep, xyz[keep, m, c])

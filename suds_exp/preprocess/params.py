@@ -95,20 +95,20 @@ def _coerce(key: str, value: Any) -> Any:
     default = DEFAULTS[key]
     if isinstance(default, str):
         if not isinstance(value, str):
-            raise ConfigError(f"--param {key}: expected text, got {value!r}")
+            raise ConfigError(f"params {key}: expected text, got {value!r}", param="params")
         return value
     if isinstance(value, bool):
-        raise ConfigError(f"--param {key}: expected a number, got {value!r}")
+        raise ConfigError(f"params {key}: expected a number, got {value!r}", param="params")
     if isinstance(value, str):
         try:
             value = float(value)
         except ValueError:
-            raise ConfigError(f"--param {key}={value}: expected a number") from None
+            raise ConfigError(f"params {key}={value}: expected a number", param="params") from None
     if not isinstance(value, int | float):
-        raise ConfigError(f"--param {key}: expected a number, got {value!r}")
+        raise ConfigError(f"params {key}: expected a number, got {value!r}", param="params")
     if isinstance(default, int):
         if value != int(value):
-            raise ConfigError(f"--param {key}={value}: expected a whole number")
+            raise ConfigError(f"params {key}={value}: expected a whole number", param="params")
         return int(value)
     return float(value)
 
@@ -117,19 +117,20 @@ def _check(params: dict[str, Any]) -> None:
     positive = ("jump_mm", "max_gap_s", "sg_window_s", "chain_window_s", "phaser_order")
     for key in positive:
         if not params[key] > 0:
-            raise ConfigError(f"--param {key}={params[key]}: must be > 0")
+            raise ConfigError(f"params {key}={params[key]}: must be > 0", param="params")
     for key in ("phaser_pad_cycles", "shape_window_s", "sg_window_cycles", "chain_window_cycles"):
         if params[key] < 0:
-            raise ConfigError(f"--param {key}={params[key]}: must be >= 0")
+            raise ConfigError(f"params {key}={params[key]}: must be >= 0", param="params")
     if not 0 <= params["sg_window_exponent"] <= 2:
         raise ConfigError(
-            f"--param sg_window_exponent={params['sg_window_exponent']}: must be 0..2"
+            f"params sg_window_exponent={params['sg_window_exponent']}: must be 0..2",
+            param="params",
         )
     if not 1 <= params["k"] <= MAX_K:
-        raise ConfigError(f"--param k={params['k']}: must be between 1 and {MAX_K}")
+        raise ConfigError(f"params k={params['k']}: must be between 1 and {MAX_K}", param="params")
     for key, top in (("sg_polyorder", 6), ("shape_polyorder", 6), ("chain_polyorder", 9)):
         if not 1 <= params[key] <= top:
-            raise ConfigError(f"--param {key}={params[key]}: must be 1..{top}")
+            raise ConfigError(f"params {key}={params[key]}: must be 1..{top}", param="params")
     for key, choices in (
         ("joint_fit", JOINT_FITS),
         ("tail_fit", TAIL_FITS),
@@ -141,7 +142,9 @@ def _check(params: dict[str, Any]) -> None:
         ("reduction", REDUCTIONS),
     ):
         if params[key] not in choices:
-            raise ConfigError(f"--param {key}={params[key]}: expected one of {', '.join(choices)}")
+            raise ConfigError(
+                f"params {key}={params[key]}: expected one of {', '.join(choices)}", param="params"
+            )
 
 
 def preset_params(preset: str) -> dict[str, Any]:
@@ -151,7 +154,9 @@ def preset_params(preset: str) -> dict[str, Any]:
     """
     if preset not in PRESETS:
         choices = ", ".join(PRESETS)
-        raise ConfigError(f"--preset {preset}: unknown preset; expected one of {choices}")
+        raise ConfigError(
+            f"preset {preset}: unknown preset; expected one of {choices}", param="preset"
+        )
     return dict(PRESETS[preset])
 
 
@@ -168,7 +173,8 @@ def resolve_params(
     for key, value in merged.items():
         if key not in DEFAULTS:
             raise ConfigError(
-                f"--param {key}: unknown parameter; expected one of {', '.join(DEFAULTS)}"
+                f"params {key}: unknown parameter; expected one of {', '.join(DEFAULTS)}",
+                param="params",
             )
         params[key] = _coerce(key, value)
     _check(params)
@@ -182,9 +188,11 @@ def parse_param_items(items: Iterable[str]) -> dict[str, str]:
         key, sep, value = item.partition("=")
         key, value = key.strip(), value.strip()
         if not sep or not key or not value:
-            raise ConfigError(f"--param {item!r}: expected KEY=VALUE, e.g. --param k=3")
+            raise ConfigError(
+                f"params {item!r}: expected KEY=VALUE, e.g. params k=3", param="params"
+            )
         if key in out:
-            raise ConfigError(f"--param {key}: given twice")
+            raise ConfigError(f"params {key}: given twice", param="params")
         out[key] = value
     return out
 
@@ -197,8 +205,6 @@ def params_json(params: Mapping[str, Any]) -> str:
 def params_hash(params: Mapping[str, Any]) -> str:
     """SHA-256 (hex) of the canonical JSON: the identity of a preprocessing version."""
     return hashlib.sha256(params_json(params).encode()).hexdigest()
-
-
 
 
 def actuated_dimension(params: Mapping[str, Any]) -> int:

@@ -33,7 +33,7 @@ import numpy as np
 from scipy.ndimage import uniform_filter1d
 from scipy.signal import hilbert
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 
 TWO_PI = 2 * np.pi
 #: Channels whose protophase advances faster or slower than channel 0's by more than this

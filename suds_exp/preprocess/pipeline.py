@@ -20,11 +20,11 @@ import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
+from suds_exp.errors import PreprocessError
 from suds_exp.ingest.layout import trial_layout
 from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
 from suds_exp.preprocess.chain import chain_settings
 from suds_exp.preprocess.clean import CleanResult, clean_tracks
-from suds_exp.preprocess.errors import PreprocessError
 from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
@@ -128,7 +128,7 @@ def _read_tracks(conn: sa.Connection, meta: pd.DataFrame) -> dict[int, tuple]:
                 lacking = [ROLES[i] for i in range(len(ROLES)) if i not in set(present)]
                 raise PreprocessError(
                     f"trial {tid}: has no marker for role(s) {', '.join(lacking)}; "
-                    "re-ingest it with a --layout naming them"
+                    "re-ingest it with a layout naming them"
                 )
             values = part[["x", "y", "z"]].to_numpy(dtype=float)
             frame_col = part.frame.to_numpy()
@@ -149,7 +149,8 @@ def _read_tracks(conn: sa.Connection, meta: pd.DataFrame) -> dict[int, tuple]:
     return out
 
 
-def _trial_meta(conn: sa.Connection, wanted: list[int] | None) -> pd.DataFrame:
+def _trial_meta(conn: sa.Connection, trial_ids: Iterable[int] | None) -> pd.DataFrame:
+    wanted = None if trial_ids is None else sorted({int(i) for i in trial_ids})
     query = sa.select(
         trials.c.id,
         trials.c.source_file,
@@ -164,7 +165,8 @@ def _trial_meta(conn: sa.Connection, wanted: list[int] | None) -> pd.DataFrame:
         unknown = sorted(set(wanted) - set(int(i) for i in meta.id))
         if unknown:
             raise PreprocessError(
-                f"--trials: no trial with id {', '.join(map(str, unknown))}; see `suds-exp trials`"
+                f"trials: no trial with id {', '.join(map(str, unknown))}; see `suds-exp trials`",
+                param="trials",
             )
         meta = meta[meta.id.isin(wanted)]
     return meta.reset_index(drop=True)
@@ -183,7 +185,7 @@ def _prepare(meta_row, tracks, params: dict) -> _Trial:
         cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in ROLES])
         measured = measure(cleaned.xyz, params["tail_fit"])
     except PreprocessError as exc:
-        raise PreprocessError(f"{label}: {exc}") from None
+        raise PreprocessError(f"{label}: {exc}", param=exc.param) from None
     gait = meta_row.gait if isinstance(meta_row.gait, str) else None
     freq = None if pd.isna(meta_row.frequency_hz) else float(meta_row.frequency_hz)
     group = _group_key(params["phaser_group"], tid, gait, freq)
@@ -289,19 +291,30 @@ def _joints_from(state: str) -> Joints:
     return Joints(np.asarray(d["head"]), np.asarray(d["tail"]), d["length_mm"], d["rms_mm"])
 
 
-def _fit_row(version_id, kind, grp, state, items: list[_Trial]) -> dict:
-    return {
-        "version_id": version_id,
-        "kind": kind,
-        "grp": grp,
-        "state": state,
-        "trial_ids": [tr.id for tr in items],
-        "n_frames": int(sum(len(tr.t) for tr in items)),
-        "fitted_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
-    }
-
-
 # -- the run ------------------------------------------------------------------------------
+@dataclass
+class Fitted:
+    """What a version holds for its trials: segment origins by trial id, the passive PCA,
+    one Phaser per trial group, and the fits this run made (`NewFit`, not yet stored)."""
+
+    joints: dict[int, Joints]
+    pca: PassivePCA
+    phasers: dict[str, Phaser]
+    new: list[NewFit] = field(default_factory=list)
+
+
+@dataclass
+class NewFit:
+    """A fitted state to store in `prep_fits`: kind, group, JSON state, the trial ids it
+    was fitted on and their number of frames."""
+
+    kind: str
+    grp: str
+    state: str
+    trial_ids: list[int]
+    n_frames: int
+
+
 def preprocess(
     store: Store,
     name: str | None = None,
@@ -338,55 +351,79 @@ def preprocess(
     started = time.perf_counter()
     params = resolve_params(params, preset)
     digest = params_hash(params)
-    wanted = None if trials is None else sorted({int(i) for i in trials})
-    v = prep_versions.c
     with store.write() as conn:
-        row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
-        if name is not None:
-            clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
-            if clash is not None and clash.params_hash != digest:
-                raise PreprocessError(
-                    f"--name {name}: version {clash.id} already has that name with other "
-                    "parameters; choose another name"
-                )
-        meta = _trial_meta(conn, wanted)
+        row = find_version(conn, name, digest)
+        meta = _trial_meta(conn, trials)
         done, fits = stored_progress(conn, None if row is None else row.id)
-        todo_meta = meta[~meta.id.isin(done)]
-        tracks = _read_tracks(conn, todo_meta) if len(todo_meta) else {}
-    skipped = sorted(int(i) for i in meta.id if int(i) in done)
+        todo = meta[~meta.id.isin(done)]
+        tracks = _read_tracks(conn, todo) if len(todo) else {}
     if meta.empty:
         raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+    result = new_result(row, name, params, digest, skipped=meta.id[meta.id.isin(done)])
+    items = clean(todo, tracks, params, progress)
+    if not items:
+        result.explained_variance_ratio = _kept_ratio(store, result.version_id, params["k"])
+        result.seconds = time.perf_counter() - started
+        return result
+    fitted = fit(items, params, fits)
+    write_version(store, result, fitted.new, fitted.pca, params["k"])
+    write_samples(store, result, items, fitted, params, progress)
+    result.explained_variance_ratio = fitted.pca.explained_variance_ratio_[: params["k"]].tolist()
+    result.seconds = time.perf_counter() - started
+    return result
 
-    # pass 1: clean and measure every trial to do; any refusal stops before writing
-    items: list[_Trial] = []
-    with progress_bar(
-        "Cleaning", total=len(todo_meta), enabled=progress and bool(len(todo_meta)), unit="trials"
-    ) as advance:
-        for meta_row in todo_meta.itertuples(index=False):
-            items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params))
-            advance()
 
-    result = PrepResult(
+def find_version(conn: sa.Connection, name: str | None, digest: str):
+    """The `prep_versions` row with parameters hash ``digest`` (None if there is none yet);
+    raises `PreprocessError` if ``name`` is already another parameter set's name."""
+    v = prep_versions.c
+    row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
+    if name is not None:
+        clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
+        if clash is not None and clash.params_hash != digest:
+            raise PreprocessError(
+                f"name {name}: version {clash.id} already has that name with other "
+                "parameters; choose another name",
+                param="name",
+            )
+    return row
+
+
+def new_result(row, name: str | None, params: dict, digest: str, skipped) -> PrepResult:
+    """The `PrepResult` of a run on version ``row`` (None: to be created as ``name``)."""
+    return PrepResult(
         version_id=row.id if row is not None else -1,
         name=row.name if row is not None else (name or ""),
         params_hash=digest,
         params=params,
         created=row is None,
-        skipped=skipped,
+        skipped=sorted(int(i) for i in skipped),
     )
-    if not items:
-        result.explained_variance_ratio = _kept_ratio(store, result.version_id, params["k"])
-        result.seconds = time.perf_counter() - started
-        return result
 
-    # fits the version lacks, on the trials of this run
-    new_fits: list[dict] = []
+
+def clean(todo: pd.DataFrame, tracks: dict[int, tuple], params: dict, progress: bool):
+    """Clean and measure every trial of ``todo`` (rows of `_trial_meta`, their tracks from
+    `_read_tracks`); any refusal raises `PreprocessError` before anything is written."""
+    items: list[_Trial] = []
+    with progress_bar(
+        "Cleaning", total=len(todo), enabled=progress and bool(len(todo)), unit="trials"
+    ) as advance:
+        for meta_row in todo.itertuples(index=False):
+            items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params))
+            advance()
+    return items
+
+
+def fit(items: list[_Trial], params: dict, fits: dict[tuple[str, str], str]) -> Fitted:
+    """Fit what the version lacks (``fits``: its stored states by (kind, group)) on the
+    trials of this run, and set each trial's kinematics."""
+    new: list[NewFit] = []
     if params["joint_fit"] == "version":
         if ("joints", "") in fits:
             shared = _joints_from(fits[("joints", "")])
         else:
             shared = fit_joints(_concat_frames(items))
-            new_fits.append(("joints", "", _joints_state(shared), items))
+            new.append(_new_fit("joints", "", _joints_state(shared), items))
         joints = {tr.id: shared for tr in items}
     else:
         joints = {tr.id: fit_joints(tr.measured.frames) for tr in items}
@@ -398,7 +435,7 @@ def preprocess(
         params, fits, lambda: np.concatenate([_smoothed(tr, params)[1] for tr in items])
     )
     if fitted is not None:
-        new_fits.append((*fitted, items))
+        new.append(_new_fit(*fitted, items))
     phasers: dict[str, Phaser] = {}
     for group in sorted({tr.group for tr in items}):
         if ("phaser", group) in fits:
@@ -411,40 +448,52 @@ def preprocess(
             )
         except PreprocessError as exc:
             raise PreprocessError(f"phase of trial group {group}: {exc}") from None
-        new_fits.append(("phaser", group, json.dumps(phasers[group].to_dict()), members))
+        new.append(_new_fit("phaser", group, json.dumps(phasers[group].to_dict()), members))
+    return Fitted(joints, pca, phasers, new)
 
-    # the version row and its new fits, in one transaction
+
+def write_version(
+    store: Store, result: PrepResult, new_fits: list[NewFit], pca, n_kept: int
+) -> None:
+    """Create the version of ``result`` if it is new (setting its id and name) and store
+    its new fits, in one transaction; a new PCA's components go to `prep_pca`, the first
+    ``n_kept`` kept."""
     with store.write() as conn:
-        if row is None:
+        if result.version_id < 0:
             vid = int(conn.exec_driver_sql("SELECT nextval('prep_versions_id_seq')").scalar_one())
-            name = name or f"v{vid}"
+            result.name = result.name or f"v{vid}"
             conn.execute(
                 sa.insert(prep_versions).values(
                     id=vid,
-                    name=name,
-                    params_hash=digest,
-                    params=params_json(params),
-                    k=params["k"],
+                    name=result.name,
+                    params_hash=result.params_hash,
+                    params=params_json(result.params),
+                    k=result.params["k"],
                     created_at=sa.func.current_timestamp(),
                 )
             )
-            result.version_id, result.name = vid, name
-        vid = result.version_id
+            result.version_id = vid
         if new_fits:
-            store.insert_df(
-                conn,
-                prep_fits.name,
-                pd.DataFrame(
-                    [
-                        _fit_row(vid, kind, grp, state, members)
-                        for kind, grp, state, members in new_fits
-                    ]
-                ),
-            )
-        if any(kind == "pca" for kind, *_ in new_fits):
-            write_pca(store, conn, vid, pca, params["k"])
+            now = pd.Timestamp.now(tz="UTC").tz_localize(None)
+            rows = [
+                {"version_id": result.version_id, **asdict(f), "fitted_at": now} for f in new_fits
+            ]
+            store.insert_df(conn, prep_fits.name, pd.DataFrame(rows))
+        if any(f.kind == "pca" for f in new_fits):
+            write_pca(store, conn, result.version_id, pca, n_kept)
 
-    # pass 2: phase, rates, samples; each batch of trials in one transaction
+
+def write_samples(
+    store: Store,
+    result: PrepResult,
+    items: list[_Trial],
+    fitted: Fitted,
+    params: dict,
+    progress: bool,
+) -> None:
+    """Phase, rates and samples of every trial, with its stats; each batch of about
+    `WRITE_BATCH_FRAMES` frames in one transaction, recorded in ``result`` once written."""
+    vid = result.version_id
     with progress_bar(
         "Preprocessing", total=len(items), enabled=progress, unit="trials"
     ) as advance:
@@ -452,18 +501,28 @@ def preprocess(
         for i, tr in enumerate(items):
             batch.append(tr)
             if sum(len(b.t) for b in batch) >= WRITE_BATCH_FRAMES or i == len(items) - 1:
-                frames = [_samples_frame(b, vid, pca, phasers[b.group], params) for b in batch]
-                stats = pd.DataFrame([_stats_row(b, vid, joints[b.id]) for b in batch])
-                with store.write() as conn:
-                    store.insert_df(conn, "samples", pd.concat(frames, ignore_index=True))
-                    store.insert_df(conn, prep_trials.name, stats)
-                result.processed.extend(b.id for b in batch)
-                result.n_samples += sum(len(f) for f in frames)
+                frames = [
+                    _samples_frame(b, vid, fitted.pca, fitted.phasers[b.group], params)
+                    for b in batch
+                ]
+                stats = pd.DataFrame([_stats_row(b, vid, fitted.joints[b.id]) for b in batch])
+                write_trials(store, result, pd.concat(frames, ignore_index=True), stats)
                 advance(len(batch))
                 batch = []
-    result.explained_variance_ratio = pca.explained_variance_ratio_[: params["k"]].tolist()
-    result.seconds = time.perf_counter() - started
-    return result
+
+
+def write_trials(store: Store, result: PrepResult, samples: pd.DataFrame, stats: pd.DataFrame):
+    """Store trials' samples and their `prep_trials` stats in one transaction, then
+    record them in ``result``."""
+    with store.write() as conn:
+        store.insert_df(conn, "samples", samples)
+        store.insert_df(conn, prep_trials.name, stats)
+    result.processed.extend(int(i) for i in stats.trial_id)
+    result.n_samples += len(samples)
+
+
+def _new_fit(kind: str, grp: str, state: str, items: list[_Trial]) -> NewFit:
+    return NewFit(kind, grp, state, [tr.id for tr in items], int(sum(len(tr.t) for tr in items)))
 
 
 def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.version import get_version
 from suds_exp.store import Store
 

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
-from suds_exp.preprocess.errors import PreprocessError
+from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.params import actuated_dimension
 from suds_exp.preprocess.phaser import Phaser
 from suds_exp.preprocess.rates import Differentiator

@@ -6,7 +6,8 @@ Public face:
   driven by prescribed joint angles (measured or commanded-through-actuator).
 - `simulate_dataset(out_dir, ...)`: gait x frequency x repeat design -> QTM TSV files,
   truth Parquet files and a manifest.
-- `effect_library()`, `set_effect(cfg, "NAME=VALUE")`, `with_effects(cfg, {...})`.
+- `effect_library()`, `set_effect(cfg, effect, {param: value})` (or
+  `set_effect(cfg, "NAME=VALUE")`), `parse_effect("NAME=VALUE")`, `with_effects(cfg, {...})`.
 - `local_connection(...)`, `save_connection(...)`, `compare_with_hatton(...)`.
 """
 
@@ -24,7 +25,13 @@ from suds_exp.sim.dataset import (
     simulate_trials,
     truth_markers,
 )
-from suds_exp.sim.effects import EFFECT_NAMES, effect_library, set_effect, with_effects
+from suds_exp.sim.effects import (
+    EFFECT_NAMES,
+    effect_library,
+    parse_effect,
+    set_effect,
+    with_effects,
+)
 from suds_exp.sim.files import TRUTH_COLUMNS
 from suds_exp.sim.gaits import FREQUENCIES_HZ, GAITS, actuate, gait_shape
 from suds_exp.sim.markers import MARKER_NAMES, marker_layout
@@ -50,6 +57,7 @@ __all__ = [
     "plan_trials",
     "residual_units",
     "save_connection",
+    "parse_effect",
     "set_effect",
     "simulate_dataset",
     "simulate_prescribed",

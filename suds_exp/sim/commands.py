@@ -1,5 +1,5 @@
 """The work behind `suds-exp simulate`, `connection` and `effects` (the CLI only parses
-options and prints), plus the option parsers they share."""
+options and prints), plus the parsers of their option strings that the CLI calls."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from suds_exp.robot import FREQUENCIES_HZ, GAITS, parse_frequency
 from suds_exp.sim.config import SimConfig, load_config
 from suds_exp.sim.connection import local_connection, save_connection
 from suds_exp.sim.dataset import simulate_dataset
-from suds_exp.sim.effects import effect_library, set_effect
+from suds_exp.sim.effects import apply_effects, effect_library
 
 
 def parse_gaits(text: str | None) -> tuple[str, ...]:
@@ -24,7 +24,9 @@ def parse_gaits(text: str | None) -> tuple[str, ...]:
     gaits = tuple(g.strip() for g in text.split(",") if g.strip())
     bad = [g for g in gaits if g not in GAITS]
     if bad or not gaits:
-        raise ConfigError(f"--gaits {text!r}: expected a comma list of {', '.join(GAITS)}")
+        raise ConfigError(
+            f"gaits {text!r}: expected a comma list of {', '.join(GAITS)}", param="gaits"
+        )
     return gaits
 
 
@@ -36,10 +38,14 @@ def parse_freqs(text: str | None) -> tuple[float, ...]:
         freqs = tuple(parse_frequency(f) for f in text.split(",") if f.strip())
     except ValueError:
         raise ConfigError(
-            f"--freqs {text!r}: expected Hz values > 0 such as 1/3,0.5,1"
+            f"frequencies_hz {text!r}: expected Hz values > 0 such as 1/3,0.5,1",
+            param="frequencies_hz",
         ) from None
     if not freqs:
-        raise ConfigError(f"--freqs {text!r}: expected Hz values > 0 such as 1/3,0.5,1")
+        raise ConfigError(
+            f"frequencies_hz {text!r}: expected Hz values > 0 such as 1/3,0.5,1",
+            param="frequencies_hz",
+        )
     return freqs
 
 
@@ -52,51 +58,66 @@ def parse_cycles(text: str | None) -> tuple[int, int]:
         lo_i = int(lo)
         hi_i = int(hi) if hi else lo_i
     except ValueError:
-        raise ConfigError(f"--cycles {text!r}: expected MIN:MAX, e.g. 10:30") from None
-    if not 1 <= lo_i <= hi_i:
-        raise ConfigError(f"--cycles {text!r}: expected 1 <= MIN <= MAX")
-    return lo_i, hi_i
+        raise ConfigError(
+            f"cycles {text!r}: expected MIN:MAX, e.g. 10:30", param="cycles"
+        ) from None
+    return check_cycles((lo_i, hi_i), text)
 
 
-def build_config(config_path: Path | None, effects: Sequence[str] = ()) -> SimConfig:
-    """Nominal config, or the file's, with `NAME=VALUE` effect settings applied in order."""
+def check_cycles(cycles: tuple[int, int], text: str | None = None) -> tuple[int, int]:
+    """``cycles`` (MIN, MAX) if 1 <= MIN <= MAX, else a `ConfigError` (quoting ``text``,
+    the string it was read from, when there is one)."""
+    lo, hi = cycles
+    if not 1 <= lo <= hi:
+        shown = repr(text) if text is not None else f"({lo}, {hi})"
+        raise ConfigError(f"cycles {shown}: expected 1 <= MIN <= MAX", param="cycles")
+    return int(lo), int(hi)
+
+
+def build_config(
+    config_path: Path | None, effects: Sequence[str] = (), param: str = "effects"
+) -> SimConfig:
+    """Nominal config, or the file's, with `NAME=VALUE` effect settings applied in order
+    (errors name ``param``, the parameter that carried them)."""
     cfg = load_config(config_path) if config_path is not None else SimConfig()
-    for assignment in effects:
-        cfg = set_effect(cfg, assignment)
-    return cfg
+    return apply_effects(cfg, effects, param)
 
 
 def simulate_command(
     out: Path,
-    config_path: Path | None = None,
-    gaits: str | None = None,
-    freqs: str | None = None,
+    config: SimConfig | None = None,
+    gaits: Sequence[str] = GAITS,
+    frequencies_hz: Sequence[float] = FREQUENCIES_HZ,
     repeats: int = 4,
-    cycles: str | None = None,
+    cycles: tuple[int, int] = (10, 30),
     seed: int = 0,
-    effects: Sequence[str] = (),
+    changes: Sequence = (),
     store=None,
     progress: Callable[[int, int], None] | None = None,
 ) -> dict:
     """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary.
 
-    `effects` may hold schedules ``NAME=VALUE@Ts`` (see `suds_exp.sim.schedule`).
+    ``config``: the simulator (default nominal); ``cycles``: (MIN, MAX) cycles per trial;
+    ``changes``: effects switched on during each trial (`suds_exp.sim.schedule.Change`,
+    from ``NAME=VALUE@Ts`` by `split_effects`).
     """
-    from suds_exp.sim.schedule import split_effects
-
-    static, changes = split_effects(effects)
-    cfg = build_config(config_path, static)
+    bad = [g for g in gaits if g not in GAITS]
+    if bad or not gaits:
+        raise ConfigError(
+            f"gaits {list(gaits)!r}: expected some of {', '.join(GAITS)}", param="gaits"
+        )
+    cycles = check_cycles(tuple(cycles))
     start = time.perf_counter()
     ds = simulate_dataset(
         out,
-        cfg,
-        gaits=parse_gaits(gaits),
-        frequencies_hz=parse_freqs(freqs),
+        config or SimConfig(),
+        gaits=tuple(gaits),
+        frequencies_hz=tuple(float(f) for f in frequencies_hz),
         repeats=repeats,
-        cycles=parse_cycles(cycles),
+        cycles=cycles,
         seed=seed,
         progress=progress,
-        changes=changes,
+        changes=list(changes),
     )
     wall = time.perf_counter() - start
     summary = {
@@ -121,13 +142,13 @@ def connection_command(
     grid: int = 21,
     half_range: float = 2.5,
     geometry: str = "robot",
-    config_path: Path | None = None,
-    effects: Sequence[str] = (),
+    config: SimConfig | None = None,
     n_directions: int = 8,
     figures: bool = True,
 ) -> dict:
-    """Compute the local connection, write CSV (+ figures); a JSON-ready summary."""
-    cfg = build_config(config_path, effects)
+    """Compute the local connection of ``config`` (default nominal), write CSV (+ figures);
+    a JSON-ready summary."""
+    cfg = config or SimConfig()
     conn = local_connection(grid, half_range, geometry, cfg, n_directions=n_directions)
     written = save_connection(conn, out, figures=figures)
     return {
@@ -141,11 +162,12 @@ def connection_command(
     }
 
 
-def effects_table(config_path: Path | None = None, effects: Sequence[str] = ()) -> pd.DataFrame:
-    """One row per effect parameter: effect, state, parameter, unit, nominal, value, range,
-    meaning (with the source of the range where there is one)."""
+def effects_table(config: SimConfig | None = None) -> pd.DataFrame:
+    """One row per effect parameter of ``config`` (default nominal): effect, state,
+    parameter, unit, nominal, value, range, meaning (with the source of the range where
+    there is one)."""
     rows = []
-    for e in effect_library(build_config(config_path, effects)):
+    for e in effect_library(config or SimConfig()):
         for p in e["parameters"]:
             rows.append(
                 {

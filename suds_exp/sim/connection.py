@@ -127,11 +127,13 @@ def local_connection(
     try:
         cfg = GEOMETRIES[geometry](config)
     except KeyError:
-        raise ConfigError(f"--geometry {geometry!r}: expected robot or classic") from None
+        raise ConfigError(
+            f"geometry {geometry!r}: expected robot or classic", param="geometry"
+        ) from None
     for key, value in (medium or {}).items():
         setattr(cfg.medium, key, value)
     if grid < 2:
-        raise ConfigError(f"--grid {grid}: need at least 2 points per axis")
+        raise ConfigError(f"grid {grid}: need at least 2 points per axis", param="grid")
     axis = np.linspace(-half_range, half_range, grid) if phi_values is None else phi_values
     axis = np.asarray(axis, dtype=float)
     if method == "lstsq":

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+from collections.abc import Mapping
 
 from suds_exp.errors import ConfigError
 from suds_exp.sim.config import (
@@ -92,21 +93,26 @@ def effect_library(config: SimConfig | None = None) -> list[dict]:
     return out
 
 
-def set_effect(config: SimConfig, assignment: str) -> SimConfig:
-    """A copy of `config` with one effect set from ``NAME=VALUE`` or ``NAME.PARAM=VALUE``.
+def parse_effect(assignment: str, param: str = "effects") -> tuple[str, dict]:
+    """``"NAME=VALUE"`` or ``"NAME.PARAM=VALUE"`` -> (effect, {parameter: value}).
 
     VALUE is a number, ``on`` / ``off`` (the main parameter's typical on value / its
-    no-effect value) or, for ``flippers``, ``free`` / ``locked`` / ``absent``.
+    no-effect value) or, for ``flippers``, ``free`` / ``locked`` / ``absent``. Errors name
+    ``param``, the parameter that carried the text.
     """
     if "=" not in assignment:
-        raise ConfigError(f"--effect {assignment!r}: expected NAME=VALUE, e.g. hinge_damping=5")
+        raise ConfigError(
+            f"{param} {assignment!r}: expected NAME=VALUE, e.g. hinge_damping=5", param=param
+        )
     key, text = (s.strip() for s in assignment.split("=", 1))
-    name, _, param = key.partition(".")
+    name, _, field_name = key.partition(".")
     cls = _effect_class(name)
     fields = {f.name: f for f in dataclasses.fields(cls)}
-    field = _main_field(name) if not param else fields.get(param)
+    field = _main_field(name) if not field_name else fields.get(field_name)
     if field is None:
-        raise ConfigError(f"--effect {assignment!r}: {name} has parameters {', '.join(fields)}")
+        raise ConfigError(
+            f"{param} {assignment!r}: {name} has parameters {', '.join(fields)}", param=param
+        )
     md = field.metadata
     if text in ("on", "off") and md.get("main"):
         value = md[text]
@@ -117,12 +123,39 @@ def set_effect(config: SimConfig, assignment: str) -> SimConfig:
             value = float(text)
         except ValueError:
             raise ConfigError(
-                f"--effect {assignment!r}: expected a number, on or off for {name}.{field.name}"
+                f"{param} {assignment!r}: expected a number, on or off for {name}.{field.name}",
+                param=param,
             ) from None
+    return name, {field.name: value}
+
+
+def set_effect(
+    config: SimConfig, effect: str, settings: Mapping[str, float | str] | None = None
+) -> SimConfig:
+    """A validated copy of ``config`` with ``settings`` ({parameter: value}) on ``effect``.
+
+    ``set_effect(config, "NAME=VALUE")`` (no ``settings``) first reads the assignment with
+    `parse_effect`; an invalid value is then reported with the assignment.
+    """
+    if settings is not None:
+        return config_from_dict({"effects": {effect: dict(settings)}}, base=config)
+    name, parsed = parse_effect(effect)
     try:
-        return config_from_dict({"effects": {name: {field.name: value}}}, base=config)
+        return config_from_dict({"effects": {name: parsed}}, base=config)
     except ConfigError as exc:
-        raise ConfigError(f"--effect {assignment!r}: {exc}") from None
+        raise ConfigError(f"effects {effect!r}: {exc}", param="effects") from None
+
+
+def apply_effects(config: SimConfig, assignments, param: str = "effects") -> SimConfig:
+    """``config`` with each ``NAME=VALUE`` of ``assignments`` set in order (`parse_effect`);
+    errors name ``param`` and the assignment."""
+    for assignment in assignments:
+        name, settings = parse_effect(assignment, param)
+        try:
+            config = set_effect(config, name, settings)
+        except ConfigError as exc:
+            raise ConfigError(f"{param} {assignment!r}: {exc}", param=param) from None
+    return config
 
 
 def with_effects(config: SimConfig, effects: dict[str, dict[str, float | str]]) -> SimConfig:

@@ -48,27 +48,31 @@ def parse_change(text: str, config: SimConfig | None = None) -> Change:
     """
     m = _AT.match(text.strip())
     if not m:
-        raise ConfigError(f"--effect {text!r}: expected NAME=VALUE@TIMEs, e.g. flippers=locked@40s")
+        raise ConfigError(
+            f"effects {text!r}: expected NAME=VALUE@TIMEs, e.g. flippers=locked@40s",
+            param="effects",
+        )
     try:
         time_s = float(m["time"])
     except ValueError:
         raise ConfigError(
-            f"--effect {text!r}: time {m['time']!r} is not a number of seconds"
+            f"effects {text!r}: time {m['time']!r} is not a number of seconds", param="effects"
         ) from None
     if not np.isfinite(time_s) or time_s <= 0:
-        raise ConfigError(f"--effect {text!r}: the change time must be > 0 s")
+        raise ConfigError(f"effects {text!r}: the change time must be > 0 s", param="effects")
     assignment = m["assignment"].strip()
     try:
         set_effect(config or SimConfig(), assignment)
     except ConfigError as exc:
-        raise ConfigError(f"{exc} (in schedule {text!r})") from None
+        raise ConfigError(f"{exc} (in schedule {text!r})", param=exc.param) from None
     return Change(assignment, time_s)
 
 
 def split_effects(
     effects: Sequence[str], config: SimConfig | None = None
 ) -> tuple[list[str], list[Change]]:
-    """``--effect`` values -> (static assignments, changes sorted by time)."""
+    """``effects`` (``NAME=VALUE`` or ``NAME=VALUE@Ts``) -> (static assignments, changes
+    sorted by time)."""
     static, changes = [], []
     for e in effects:
         if "@" in e:
@@ -87,8 +91,9 @@ def check_times(changes: Sequence[Change], durations: dict[str, float]) -> None:
         for name, d in durations.items():
             if c.time_s >= d:
                 raise ConfigError(
-                    f"--effect {str(c)!r}: {c.time_s:g} s is past the end of trial {name} "
-                    f"({d:g} s long); give an earlier time or more --cycles"
+                    f"effects {str(c)!r}: {c.time_s:g} s is past the end of trial {name} "
+                    f"({d:g} s long); give an earlier time or more cycles",
+                    param=("effects", "cycles"),
                 )
 
 

@@ -65,13 +65,8 @@ class Store:
         """
         if not self._migrated:
             self.upgrade()
-        engine = make_engine(self.path)
-        try:
-            conn = retry_on_lock(engine.connect, self.path)
-            with conn:
-                yield conn
-        finally:
-            engine.dispose()
+        with self._connect(read_only=False) as conn:
+            yield conn
 
     @contextmanager
     def write(self) -> Iterator[sa.Connection]:
@@ -84,7 +79,13 @@ class Store:
         """A read-only connection; refuses a file that does not exist."""
         if not self.path.exists():
             raise StoreError(f"{self.path}: no database here; create one with `suds-exp init`")
-        engine = make_engine(self.path, read_only=True)
+        with self._connect(read_only=True) as conn:
+            yield conn
+
+    @contextmanager
+    def _connect(self, read_only: bool) -> Iterator[sa.Connection]:
+        # one engine per block, disposed at its end, so the file is held only inside it
+        engine = make_engine(self.path, read_only=read_only)
         try:
             conn = retry_on_lock(engine.connect, self.path)
             with conn:

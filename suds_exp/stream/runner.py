@@ -22,16 +22,12 @@ import sqlalchemy as sa
 
 from suds_exp.campaign.definition import differences, resolve_models
 from suds_exp.campaign.lock import RunLock
-from suds_exp.errors import SudsError
+from suds_exp.errors import StreamError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 from suds_exp.stream.prequential import StreamSettings, run_trial, trial_cycles
 
 _SCHEDULE = re.compile(r"schedule=\S+@([0-9.eE+-]+)s")
-
-
-class StreamError(SudsError):
-    """A stream cannot run as asked (bad option, definition differs from the stored one)."""
 
 
 @dataclass
@@ -95,50 +91,13 @@ def run_stream(
     instead of loading `prep` (tests, benchmarks; `prep` then only labels it).
     on_unit(n_done) is called after each written (learner, trial).
     """
-    from suds_exp.preprocess import get_version
-
     settings = settings or StreamSettings()
     if settings.warmup_cycles < 1:
-        raise StreamError(f"--warmup: {settings.warmup_cycles}; expected >= 1 cycle")
-    if samples is None:
-        version = get_version(store, prep)
-        prep = version.name
-        samples = version.samples(trials)
-    else:
-        prep = prep or "(samples given)"
-        if trials is not None:
-            samples = samples[samples["trial_id"].isin(trials)]
-    present = sorted(int(t) for t in samples["trial_id"].unique())
-    if trials is not None:
-        missing = sorted(set(int(t) for t in trials) - set(present))
-        if missing:
-            raise StreamError(
-                f"--trials: no samples of trial(s) {', '.join(map(str, missing))} "
-                f"in preprocessing version {prep}"
-            )
-    trials = present
-    if not trials:
-        raise StreamError(f"no samples in preprocessing version {prep}")
-    if change_at is not None:
-        changes: dict[int, float | None] = {t: float(change_at) for t in trials}
-    elif store.path.exists():
-        changes = change_times(store, trials) if _has_trials(store) else {t: None for t in trials}
-    else:
-        changes = {t: None for t in trials}
-    ends = samples.groupby("trial_id")["t"].max()
-    for t, c in changes.items():
-        if c is not None and not 0 < c < float(ends[t]):
-            raise StreamError(
-                f"change at {c:g} s: past the end of trial {t} ({float(ends[t]):.1f} s long); "
-                "expected 0 < time < the trial's duration"
-            )
-    for tid, g in samples.groupby("trial_id"):
-        n = len(trial_cycles(g, settings.min_samples))
-        if n <= settings.warmup_cycles:
-            raise StreamError(
-                f"trial {tid}: {n} whole cycles, not more than --warmup "
-                f"{settings.warmup_cycles}; give longer trials or a shorter warm-up"
-            )
+        raise StreamError(
+            f"warmup_cycles: {settings.warmup_cycles}; expected >= 1 cycle", param="warmup_cycles"
+        )
+    prep, samples, trials = _stream_samples(store, prep, trials, samples)
+    changes = _stream_changes(store, samples, trials, change_at, settings)
     definition = _definition(models, trials, prep, settings, changes)
     summary = StreamSummary(name, len(definition["models"]) * len(trials), 0, trials=trials)
     with RunLock(store.path, name):
@@ -165,6 +124,61 @@ def run_stream(
                     if on_unit is not None:
                         on_unit(summary.done_before + summary.done_now)
     return summary
+
+
+def _stream_samples(store: Store, prep, trials, samples):
+    """The version's name, the samples of ``trials`` and their trial ids (every one asked
+    for must be there)."""
+    from suds_exp.preprocess import get_version
+
+    if samples is None:
+        version = get_version(store, prep)
+        prep = version.name
+        samples = version.samples(trials)
+    else:
+        prep = prep or "(samples given)"
+        if trials is not None:
+            samples = samples[samples["trial_id"].isin(trials)]
+    present = sorted(int(t) for t in samples["trial_id"].unique())
+    if trials is not None:
+        missing = sorted(set(int(t) for t in trials) - set(present))
+        if missing:
+            raise StreamError(
+                f"trials: no samples of trial(s) {', '.join(map(str, missing))} "
+                f"in preprocessing version {prep}",
+                param="trials",
+            )
+    trials = present
+    if not trials:
+        raise StreamError(f"no samples in preprocessing version {prep}")
+    return prep, samples, trials
+
+
+def _stream_changes(store: Store, samples, trials, change_at, settings) -> dict:
+    """Trial id -> change time (s, None: no change), each inside its trial; every trial
+    must have more whole cycles than the warm-up."""
+    if change_at is not None:
+        changes: dict[int, float | None] = {t: float(change_at) for t in trials}
+    elif store.path.exists():
+        changes = change_times(store, trials) if _has_trials(store) else {t: None for t in trials}
+    else:
+        changes = {t: None for t in trials}
+    ends = samples.groupby("trial_id")["t"].max()
+    for t, c in changes.items():
+        if c is not None and not 0 < c < float(ends[t]):
+            raise StreamError(
+                f"change at {c:g} s: past the end of trial {t} ({float(ends[t]):.1f} s long); "
+                "expected 0 < time < the trial's duration"
+            )
+    for tid, g in samples.groupby("trial_id"):
+        n = len(trial_cycles(g, settings.min_samples))
+        if n <= settings.warmup_cycles:
+            raise StreamError(
+                f"trial {tid}: {n} whole cycles, not more than warmup_cycles "
+                f"{settings.warmup_cycles}; give longer trials or a shorter warm-up",
+                param="warmup_cycles",
+            )
+    return changes
 
 
 def _has_trials(store: Store) -> bool:

@@ -56,25 +56,46 @@ def run_demo(
 
     ``report_dir / campaign`` receives the campaign report and
     ``report_dir / "discrepancy-demo"`` the discrepancy report of ``hidden_effect``
-    hidden in new simulated data. ``say`` gets one line per finished step.
+    hidden in new simulated data. ``say`` gets one line per finished step (the demo's
+    narration, its output rather than its progress).
     """
-    from suds_exp.analysis import findings, write_report
-    from suds_exp.analysis.findings import findings_display, findings_headline, findings_json
-    from suds_exp.campaign.demo import demo_campaign
-    from suds_exp.discrepancy.demo import demo_discrepancy
-    from suds_exp.ingest import ingest_paths
-    from suds_exp.preprocess import preprocess
-    from suds_exp.sim import simulate_dataset
+    from suds_exp.analysis import write_report
+    from suds_exp.testing.demo_campaign import demo_campaign
 
     summary = DemoSummary(campaign=campaign)
-    clock = time.perf_counter()
+    lap = _Clock(summary).lap
+    simulate_and_ingest(store, summary, seed, progress, say, lap)
+    prep_name = preprocess_step(store, summary, progress, say, lap)
+    run = demo_campaign(store, campaign, prep=prep_name, jobs=jobs, progress=progress)
+    summary.n_results = run.done_before + run.done_now
+    say(
+        f"campaign {campaign!r}: {summary.n_results} of {run.total_jobs} jobs done "
+        f"({lap('campaign'):.0f} s)"
+    )
+    summary.report = write_report(store, campaign, report_dir / campaign)
+    say(f"report written to {summary.report} ({lap('report'):.0f} s)")
+    findings_step(store, summary, say, lap)
+    discrepancy_step(summary, report_dir / "discrepancy-demo", hidden_effect, seed, say, lap)
+    return summary
 
-    def lap(step: str) -> float:
-        nonlocal clock
+
+class _Clock:
+    """``lap(step)``: seconds since the previous lap, recorded in the summary."""
+
+    def __init__(self, summary: DemoSummary):
+        self.summary, self.clock = summary, time.perf_counter()
+
+    def lap(self, step: str) -> float:
         now = time.perf_counter()
-        summary.seconds[step] = now - clock
-        clock = now
-        return summary.seconds[step]
+        self.summary.seconds[step] = now - self.clock
+        self.clock = now
+        return self.summary.seconds[step]
+
+
+def simulate_and_ingest(store: Store, summary: DemoSummary, seed: int, progress, say, lap):
+    """Simulate the paper's design into a temporary folder and ingest it."""
+    from suds_exp.ingest import ingest_paths
+    from suds_exp.sim import simulate_dataset
 
     with tempfile.TemporaryDirectory(prefix="suds-demo-") as tmp:
         with progress_bar("Simulating", total=60, enabled=progress, unit="trials") as advance:
@@ -91,12 +112,17 @@ def run_demo(
             # same conditions: never overwrite it, say how to run the demo anyway.
             raise IngestError(
                 f"{exc} -- the demo's simulated trials clash with trials already in "
-                f"{store.path}; run the demo on its own database: suds-exp demo --db demo.duckdb"
+                f"{store.path}; run the demo on a database of its own, e.g. demo.duckdb"
             ) from None
         summary.n_trials = len(results)
         fresh = sum(r.status == "ingested" for r in results)
         stored = len(results) - fresh
         say(f"ingested {fresh} new trials ({stored} already stored) in {lap('ingest'):.0f} s")
+
+
+def preprocess_step(store: Store, summary: DemoSummary, progress, say, lap) -> str:
+    """Preprocess with the default parameters; the version's name."""
+    from suds_exp.preprocess import preprocess
 
     prep = preprocess(store, progress=progress)
     summary.prep_version = prep.name
@@ -107,17 +133,15 @@ def run_demo(
         f"{100 * sum(prep.explained_variance_ratio):.0f}% of the variance "
         f"({lap('preprocess'):.0f} s)"
     )
+    return prep.name
 
-    run = demo_campaign(store, campaign, prep=prep.name, jobs=jobs, progress=progress)
-    summary.n_results = run.done_before + run.done_now
-    say(
-        f"campaign {campaign!r}: {summary.n_results} of {run.total_jobs} jobs done "
-        f"({lap('campaign'):.0f} s)"
-    )
 
-    summary.report = write_report(store, campaign, report_dir / campaign)
-    say(f"report written to {summary.report} ({lap('report'):.0f} s)")
+def findings_step(store: Store, summary: DemoSummary, say, lap) -> None:
+    """The paper's findings measured on the demo campaign."""
+    from suds_exp.analysis import findings
+    from suds_exp.analysis.findings import findings_display, findings_headline, findings_json
 
+    campaign = summary.campaign
     table = findings(store, campaign)  # the same table as the report's first section
     summary.findings = findings_json(table, campaign)["statistics"]
     summary.findings_headline = findings_headline(table)
@@ -130,9 +154,13 @@ def run_demo(
     say(display.to_string(index=False, max_colwidth=60))
     say(f"{summary.findings_headline} ({lap('findings'):.0f} s)")
 
+
+def discrepancy_step(summary: DemoSummary, out: Path, hidden_effect: str, seed: int, say, lap):
+    """Hide ``hidden_effect`` in new simulated data and let the workflow name it."""
+    from suds_exp.testing.hidden_effects import demo_discrepancy
+
     # The hidden-effect data lives in its own temporary database: it re-uses the
     # conditions of the demo's data with different content, which ingest would refuse.
-    out = report_dir / "discrepancy-demo"
     found = demo_discrepancy(effect=hidden_effect, seed=seed, out=out)
     summary.discrepancy = found
     summary.discrepancy_report = out / "index.html"
@@ -154,4 +182,3 @@ def run_demo(
         f"held-out RMS error of vx {found['rmse_vx_before']:.2f} -> "
         f"{found['rmse_vx_after']:.2f} mm/s ({lap('discrepancy'):.0f} s)"
     )
-    return summary

@@ -43,6 +43,7 @@ HALF_WIDTH_MM = 20.0
 FLIPPER_MARKER_MM = 30.0
 FLIPPER_HEIGHT_MM = 30.0
 
+
 @dataclass
 class SyntheticTrial:
     """One synthetic capture: ``xyz`` (n_frames, 11, 3) mm in `ROLES` order (NaN = not
@@ -58,19 +59,8 @@ class SyntheticTrial:
     dropped: np.ndarray
 
 
-def synthetic_trial(
-    gait: str = "O",
-    frequency_hz: float = 0.5,
-    n_cycles: float = 10.0,
-    rate_hz: float = 100.0,
-    noise_mm: float = 0.2,
-    n_jumps: int = 0,
-    n_dropouts: int = 0,
-    tilt_rad: float = 0.03,
-    seed: int = 0,
-) -> SyntheticTrial:
-    """Build a synthetic trial (see the module docstring); all randomness from ``seed``."""
-    rng = np.random.default_rng(seed)
+def _body_motion(rng, gait: str, frequency_hz: float, n_cycles: float, rate_hz: float):
+    """Commanded shape, flippers and the body's prescribed motion (s, rad, mm, mm/s)."""
     n = int(round(n_cycles * rate_hz / frequency_hz))
     t = np.arange(n) / rate_hz
     phase0 = rng.uniform(0, 2 * np.pi)
@@ -98,6 +88,12 @@ def synthetic_trial(
     x = cumulative_trapezoid(dx, tf, initial=0.0)[::fine] + rng.uniform(-200, 200)
     y = cumulative_trapezoid(dy, tf, initial=0.0)[::fine] + rng.uniform(-200, 200)
 
+    return t, theta, phi, flips, vx, vy, wz, heading, x, y
+
+
+def _markers(x, y, heading, phi, flips) -> np.ndarray:
+    """Marker positions (n, 11, 3) mm in `ROLES` order on the rigid segments."""
+    n = len(x)
     seg_heading = {"head": heading + phi[:, 0], "tail": heading - phi[:, 1]}
     ch, sh = np.cos(heading), np.sin(heading)
     joint = {
@@ -128,6 +124,13 @@ def synthetic_trial(
             )
             xyz[:, m] = place(segment, local, FLIPPER_HEIGHT_MM)
 
+    return xyz
+
+
+def _capture_errors(xyz, rng, noise_mm, tilt_rad, n_jumps, n_dropouts):
+    """The scene tilted and offset in the capture volume, with noise, jumps and dropouts;
+    masks (n, 11) of jumped and dropped points."""
+    n = len(xyz)
     # tilt and offset the whole scene in the capture volume
     rot = Rotation.from_rotvec(tilt_rad * np.array([0.6, 0.8, 0.0]))
     xyz = rot.apply(xyz.reshape(-1, 3)).reshape(xyz.shape) + np.array([150.0, -80.0, 30.0])
@@ -150,6 +153,27 @@ def synthetic_trial(
     xyz[dropped] = np.nan
     jumped &= ~dropped
 
+    return xyz, jumped, dropped
+
+
+def synthetic_trial(
+    gait: str = "O",
+    frequency_hz: float = 0.5,
+    n_cycles: float = 10.0,
+    rate_hz: float = 100.0,
+    noise_mm: float = 0.2,
+    n_jumps: int = 0,
+    n_dropouts: int = 0,
+    tilt_rad: float = 0.03,
+    seed: int = 0,
+) -> SyntheticTrial:
+    """Build a synthetic trial (see the module docstring); all randomness from ``seed``."""
+    rng = np.random.default_rng(seed)
+    t, theta, phi, flips, vx, vy, wz, heading, x, y = _body_motion(
+        rng, gait, frequency_hz, n_cycles, rate_hz
+    )
+    xyz = _markers(x, y, heading, phi, flips)
+    xyz, jumped, dropped = _capture_errors(xyz, rng, noise_mm, tilt_rad, n_jumps, n_dropouts)
     truth = pd.DataFrame(
         {
             "t": t,

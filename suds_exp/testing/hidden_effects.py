@@ -14,10 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from suds_exp.discrepancy.effects import main_parameter, set_effect
+from suds_exp.discrepancy.effects import main_parameter
 from suds_exp.discrepancy.workflow import DiscrepancyOptions, DiscrepancyResult, run_discrepancy
 from suds_exp.robot import FREQUENCIES_HZ
 from suds_exp.sim.config import SimConfig
+from suds_exp.sim.effects import set_effect
 
 #: Hidden-effect settings for the checks: (effect, fixed settings, drawn parameter).
 HIDDEN: dict[str, tuple[dict, str]] = {
@@ -126,7 +127,7 @@ def hidden_effect_run(
     cycles: tuple[int, int] = (4, 6),
     options: DiscrepancyOptions | None = None,
     out: str | Path | None = None,
-    log=None,
+    progress: bool = False,
 ) -> HiddenRun:
     """Simulate "measured" data with ``hidden`` effects ({effect: settings}, e.g.
     ``{"body_inertia": {"tau_s": 0.2}}``; None or {}: the nominal robot) and run the
@@ -149,7 +150,7 @@ def hidden_effect_run(
             name=f"hidden-{seed}",
             options=opts,
             out=out,
-            log=log,
+            progress=progress,
         )
     return HiddenRun(hidden, result)
 
@@ -158,7 +159,7 @@ def demo_discrepancy(
     effect: str = "body_inertia",
     seed: int = 0,
     out: str | Path | None = None,
-    log=None,
+    progress: bool = False,
     **design,
 ) -> dict:
     """`suds-exp demo`'s last act: hide ``effect`` (parameter drawn with ``seed``) in
@@ -172,7 +173,7 @@ def demo_discrepancy(
     """
     rng = np.random.default_rng(seed)
     settings = draw_hidden(effect, rng)
-    run = hidden_effect_run({effect: settings}, seed=seed, out=out, log=log, **design)
+    run = hidden_effect_run({effect: settings}, seed=seed, out=out, progress=progress, **design)
     res = run.result
     return {
         "hidden": {effect: settings},
