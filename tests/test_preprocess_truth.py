@@ -6,7 +6,6 @@ trials, about 240k frames).
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -49,16 +48,14 @@ def test_simulated_trials_give_shape_and_phase_within_targets(small):
 def default_dataset(tmp_path_factory):
     folder = tmp_path_factory.mktemp("simdefault")
     store = simulated_store(folder, seed=0)
-    started = time.perf_counter()
-    result = preprocess(store, progress=False)
-    return store, result, time.perf_counter() - started
+    return store, preprocess(store, progress=False)
 
 
 @pytest.mark.slow
-def test_default_dataset_within_targets_and_under_30_s(default_dataset):
-    store, result, seconds = default_dataset
+def test_default_dataset_within_targets(default_dataset):
+    # its speed (target: under 30 s) is measured by benchmarks/preprocess.py, not here
+    store, result = default_dataset
     assert len(result.processed) == 60
-    assert seconds < 30
     pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]
     assert pooled.err_ra <= 0.01
     assert pooled.err_phase <= 0.05
@@ -68,7 +65,7 @@ def test_default_dataset_within_targets_and_under_30_s(default_dataset):
 
 @pytest.mark.slow
 def test_default_dataset_body_velocity_within_5_percent_of_raw_truth(default_dataset):
-    store, result, _ = default_dataset
+    store, result = default_dataset
     pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]
     for column in ("err_vx", "err_vy", "err_wz"):
         assert pooled[column] <= 0.05 * pooled.rms_vx_true, column

@@ -204,22 +204,15 @@ def test_batched_trials_equal_single_trials():
 
 
 @pytest.mark.slow
-def test_default_dataset_physics_converges_and_is_fast():
-    import time
-
+def test_default_dataset_physics_converges_and_keeps_flippers_within_stops():
     from suds_exp.sim import plan_trials, simulate_trials
 
     cfg = SimConfig()
     specs = plan_trials()
-    simulate_trials(specs[:1], cfg)
-    start = time.process_time()
     truths = simulate_trials(specs, cfg)
-    cpu = time.process_time() - start
-    robot_seconds = sum(t["t"][-1] for t in truths)
     assert max(np.nanmax(t["residual"]) for t in truths) <= cfg.solver.tol
     amax = math.radians(cfg.hinges.open_stop_deg)
     for t in truths:
         fl = np.column_stack([t[f"flipper_{i}"] for i in range(1, 5)])
         assert fl.min() >= 0 and fl.max() <= amax + 1e-12
-    # issue 3: at least 100x real time per core (target 300x; ~580x measured)
-    assert robot_seconds / cpu > 100
+    # its speed (target 300x real time per core) is measured by benchmarks/sim.py
