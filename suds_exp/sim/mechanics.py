@@ -200,27 +200,75 @@ def simulate_prescribed(
         ``residual`` (max scaled force/torque residual of the solves ending at each frame,
         see `residual_units`), ``iterations`` and ``continuations`` (n_trials,).
     """
+    phi, single = _as_batch(phi)
+    n_trials, n_max = phi.shape[:2]
+    if not dt > 0:
+        raise ConfigError(f"dt: expected a positive sample interval in s, got {dt}")
+    configs = _configs(config, n_trials)
+    table = element_table(configs[0])
+    prm = np.stack([pack_params(c) for c in configs])
+    if not commanded:
+        # angles are followed exactly, whatever the servo's settings
+        prm[:, rft.P_SGAIN] = 0.0
+    lengths = _lengths(phi, n_frames)
+    p0, a0 = _initial_state(pose0, flippers0, n_trials)
+    bed_modes, bed_scale = _beds(configs, trial_seeds)
+    out = {
+        "pose": np.full((n_trials, n_max, 3), np.nan),
+        "vel": np.full((n_trials, n_max, 3), np.nan),
+        "flippers": np.full((n_trials, n_max, 4), np.nan),
+        "phi": np.full((n_trials, n_max, 2), np.nan),
+        "residual": np.full((n_trials, n_max), np.nan),
+        "iterations": np.zeros(n_trials, dtype=np.int64),
+        "continuations": np.zeros(n_trials, dtype=np.int64),
+    }
+    rft.run_trials(
+        np.ascontiguousarray(phi),
+        lengths,
+        p0,
+        a0,
+        prm,
+        *table.kernel_args(),
+        float(dt),
+        bed_modes,
+        bed_scale,
+        *(out[k] for k in ("pose", "vel", "flippers", "phi", "residual")),
+        out["iterations"],
+        out["continuations"],
+    )
+    if single:
+        out = {k: v[0] for k, v in out.items()}
+    return out
+
+
+def _as_batch(phi) -> tuple[np.ndarray, bool]:
+    """phi as (n_trials, n_frames, 2) and whether one trial (n_frames, 2) was given."""
     phi = np.asarray(phi, dtype=float)
     single = phi.ndim == 2
     if single:
         phi = phi[None]
     if phi.ndim != 3 or phi.shape[2] != 2:
         raise ConfigError(f"phi: expected shape (n_trials, n_frames, 2), got {phi.shape}")
-    n_trials, n_max = phi.shape[:2]
-    if not dt > 0:
-        raise ConfigError(f"dt: expected a positive sample interval in s, got {dt}")
-    configs = (
-        [SimConfig()] * n_trials
-        if config is None
-        else list(config)
-        if isinstance(config, list | tuple)
-        else [config] * n_trials
-    )
+    return phi, single
+
+
+def _configs(config, n_trials: int) -> list[SimConfig]:
+    """One configuration per trial, all of the same geometry."""
+    if config is None:
+        configs = [SimConfig()] * n_trials
+    elif isinstance(config, list | tuple):
+        configs = list(config)
+    else:
+        configs = [config] * n_trials
     if len(configs) != n_trials:
         raise ConfigError(f"config: got {len(configs)} configs for {n_trials} trials")
     _same_geometry(configs)
-    table = element_table(configs[0])
-    prm = np.stack([pack_params(c) for c in configs])
+    return configs
+
+
+def _lengths(phi: np.ndarray, n_frames) -> np.ndarray:
+    """Valid frames per trial (n_trials,), checked against phi's finite samples."""
+    n_trials, n_max = phi.shape[:2]
     lengths = (
         np.full(n_trials, n_max, dtype=np.int64)
         if n_frames is None
@@ -228,12 +276,14 @@ def simulate_prescribed(
     )
     if lengths.min(initial=1) < 1 or lengths.max(initial=0) > n_max:
         raise ConfigError("n_frames: each trial needs 1..n_frames samples")
-    if not commanded:
-        # angles are followed exactly, whatever the servo's settings
-        prm[:, rft.P_SGAIN] = 0.0
     for k in range(n_trials):
         if not np.all(np.isfinite(phi[k, : lengths[k]])):
             raise ConfigError(f"phi: trial {k} has non-finite joint angles")
+    return lengths
+
+
+def _initial_state(pose0, flippers0, n_trials: int) -> tuple[np.ndarray, np.ndarray]:
+    """Initial poses (n_trials, 3) mm, rad and flipper angles (n_trials, 4) rad."""
     try:
         p0 = np.broadcast_to(
             np.zeros(3) if pose0 is None else np.asarray(pose0, float), (n_trials, 3)
@@ -245,48 +295,14 @@ def simulate_prescribed(
         raise ConfigError(
             "pose0 / flippers0: expected shapes (n_trials, 3) / (n_trials, 4) or one row"
         ) from None
-    pose = np.full((n_trials, n_max, 3), np.nan)
-    vel = np.full((n_trials, n_max, 3), np.nan)
-    ang = np.full((n_trials, n_max, 4), np.nan)
-    phi_real = np.full((n_trials, n_max, 2), np.nan)
-    if trial_seeds is not None and len(trial_seeds) != n_trials:
-        raise ConfigError(f"trial_seeds: got {len(trial_seeds)} seeds for {n_trials} trials")
+    return p0, a0
+
+
+def _beds(configs: list[SimConfig], trial_seeds) -> tuple[np.ndarray, np.ndarray]:
+    """Each trial's bed: random modes (n_trials, n_modes, 4) and packing factor (n_trials,)."""
+    if trial_seeds is not None and len(trial_seeds) != len(configs):
+        raise ConfigError(f"trial_seeds: got {len(trial_seeds)} seeds for {len(configs)} trials")
     beds = [
         draw_bed(c, None if trial_seeds is None else trial_seeds[k]) for k, c in enumerate(configs)
     ]
-    bed_modes = np.stack([b[0] for b in beds])
-    bed_scale = np.array([b[1] for b in beds])
-    resid = np.full((n_trials, n_max), np.nan)
-    iters = np.zeros(n_trials, dtype=np.int64)
-    n_cont = np.zeros(n_trials, dtype=np.int64)
-    rft.run_trials(
-        np.ascontiguousarray(phi),
-        lengths,
-        p0,
-        a0,
-        prm,
-        *table.kernel_args(),
-        float(dt),
-        bed_modes,
-        bed_scale,
-        pose,
-        vel,
-        ang,
-        phi_real,
-        resid,
-        iters,
-        n_cont,
-    )
-    phi_out = phi_real
-    out = {
-        "pose": pose,
-        "vel": vel,
-        "flippers": ang,
-        "phi": phi_out,
-        "residual": resid,
-        "iterations": iters,
-        "continuations": n_cont,
-    }
-    if single:
-        out = {k: v[0] for k, v in out.items()}
-    return out
+    return np.stack([b[0] for b in beds]), np.array([b[1] for b in beds])
