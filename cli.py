@@ -222,7 +222,6 @@ def simulate(
 
     Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on
     """
-    from suds_exp.progress import progress_bar
     from suds_exp.sim.commands import (
         build_config,
         parse_cycles,
@@ -235,21 +234,18 @@ def simulate(
     gait_list, freq_list, cycle_range = parse_gaits(gaits), parse_freqs(freqs), parse_cycles(cycles)
     static, changes = split_effects(effect or [])
     sim_config = build_config(config, static)
-    n = len(gait_list) * len(freq_list) * repeats
-    bar = progress_bar("Simulating", total=n, enabled=not (quiet or json_), unit="trials")
-    with bar as advance:
-        summary = simulate_command(
-            out,
-            sim_config,
-            gait_list,
-            freq_list,
-            repeats,
-            cycle_range,
-            seed,
-            changes,
-            store=open_store(db) if ingest else None,
-            progress=lambda done, total: advance(),
-        )
+    summary = simulate_command(
+        out,
+        sim_config,
+        gait_list,
+        freq_list,
+        repeats,
+        cycle_range,
+        seed,
+        changes,
+        store=open_store(db) if ingest else None,
+        progress=not (quiet or json_),
+    )
     if json_:
         console.print_json(summary)
     else:

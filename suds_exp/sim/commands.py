@@ -4,7 +4,7 @@ options and prints), plus the parsers of their option strings that the CLI calls
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
@@ -93,13 +93,13 @@ def simulate_command(
     seed: int = 0,
     changes: Sequence = (),
     store=None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: bool = False,
 ) -> dict:
     """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary.
 
     ``config``: the simulator (default nominal); ``cycles``: (MIN, MAX) cycles per trial;
     ``changes``: effects switched on during each trial (`suds_exp.sim.schedule.Change`,
-    from ``NAME=VALUE@Ts`` by `split_effects`).
+    from ``NAME=VALUE@Ts`` by `split_effects`); ``progress``: a bar over the trials.
     """
     bad = [g for g in gaits if g not in GAITS]
     if bad or not gaits:

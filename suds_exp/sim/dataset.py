@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from suds_exp.errors import ConfigError
+from suds_exp.progress import progress_bar
 from suds_exp.robot import FREQUENCIES_HZ, GAITS, gait_shape
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.files import write_manifest, write_qtm_tsv, write_truth
@@ -192,7 +193,7 @@ def simulate_dataset(
     repeats: int = 4,
     cycles: tuple[int, int] = (10, 30),
     seed: int = 0,
-    progress: Callable[[int, int], None] | None = None,
+    progress: bool = False,
     batch_size: int = 20,
     changes: Sequence = (),
 ) -> SimulatedDataset:
@@ -200,7 +201,7 @@ def simulate_dataset(
 
     Writes `<trial>.tsv` (QTM export of the 11 markers), `<trial>.truth.parquet` and
     `manifest.csv`. Default: the paper's design, 5 gaits x 3 frequencies x 4 repeats,
-    10-30 cycles each. `progress(done, total)` is called after each written trial.
+    10-30 cycles each. ``progress``: a bar over the written trials.
     `changes` (`schedule.Change` items) switch effects on during every trial; they are
     noted in the manifest as ``schedule=NAME=VALUE@Ts``.
     """
@@ -218,34 +219,41 @@ def simulate_dataset(
         check_times(changes, {sp.name: sp.n_cycles / sp.frequency_hz for sp in specs})
     rows, tsvs, truths_written = [], [], []
     seconds = 0.0
-    rate = cfg.measurement.sample_rate_hz
-    for start in range(0, len(specs), batch_size):
-        batch = specs[start : start + batch_size]
-        for spec, truth in zip(batch, simulate_trials(batch, cfg, changes), strict=True):
-            rng = np.random.default_rng(np.random.SeedSequence(spec.seed + (2,)))
-            measured = measure(cfg, truth_markers(truth, cfg), rng)
-            tsv = out / f"{spec.name}.tsv"
-            # a plausible session clock: one hour per gait, a minute per repeat
-            g, mhz, r = spec.seed[1], spec.seed[2] // 1000, spec.seed[3]
-            stamp = _EPOCH + _dt.timedelta(seconds=3600 * g + 60 * r + mhz)
-            write_qtm_tsv(tsv, measured, MARKER_NAMES, rate, stamp)
-            truth_path = out / f"{spec.name}.truth.parquet"
-            write_truth(truth_path, truth)
-            seconds += truth["t"][-1]
-            rows.append(
-                {
-                    "file": tsv.name,
-                    "gait": spec.gait,
-                    "frequency_hz": f"{spec.frequency_hz:.6f}",
-                    "repeat": spec.repeat,
-                    "notes": f"simulated seed={spec.seed[0]} cycles={spec.n_cycles}"
-                    + "".join(f" schedule={c}" for c in changes),
-                }
-            )
-            tsvs.append(tsv)
-            truths_written.append(truth_path)
-            if progress is not None:
-                progress(len(tsvs), len(specs))
+    with progress_bar("Simulating", len(specs), enabled=progress, unit="trials") as advance:
+        for start in range(0, len(specs), batch_size):
+            batch = specs[start : start + batch_size]
+            for spec, truth in zip(batch, simulate_trials(batch, cfg, changes), strict=True):
+                row, tsv, truth_path = _write_trial(out, spec, truth, cfg, changes)
+                rows.append(row)
+                tsvs.append(tsv)
+                truths_written.append(truth_path)
+                seconds += truth["t"][-1]
+                advance()
     manifest = out / "manifest.csv"
     write_manifest(manifest, rows)
     return SimulatedDataset(tsvs, truths_written, manifest, seconds)
+
+
+def _write_trial(
+    out: Path, spec: TrialSpec, truth: dict, cfg: SimConfig, changes: Sequence
+) -> tuple[dict, Path, Path]:
+    """Measure one simulated trial's markers, write its QTM TSV and truth Parquet files;
+    (manifest row, TSV path, truth path)."""
+    rng = np.random.default_rng(np.random.SeedSequence(spec.seed + (2,)))
+    measured = measure(cfg, truth_markers(truth, cfg), rng)
+    tsv = out / f"{spec.name}.tsv"
+    # a plausible session clock: one hour per gait, a minute per repeat
+    g, mhz, r = spec.seed[1], spec.seed[2] // 1000, spec.seed[3]
+    stamp = _EPOCH + _dt.timedelta(seconds=3600 * g + 60 * r + mhz)
+    write_qtm_tsv(tsv, measured, MARKER_NAMES, cfg.measurement.sample_rate_hz, stamp)
+    truth_path = out / f"{spec.name}.truth.parquet"
+    write_truth(truth_path, truth)
+    row = {
+        "file": tsv.name,
+        "gait": spec.gait,
+        "frequency_hz": f"{spec.frequency_hz:.6f}",
+        "repeat": spec.repeat,
+        "notes": f"simulated seed={spec.seed[0]} cycles={spec.n_cycles}"
+        + "".join(f" schedule={c}" for c in changes),
+    }
+    return row, tsv, truth_path

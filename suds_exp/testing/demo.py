@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from suds_exp.errors import IngestError
-from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 
 
@@ -98,8 +97,7 @@ def simulate_and_ingest(store: Store, summary: DemoSummary, seed: int, progress,
     from suds_exp.sim import simulate_dataset
 
     with tempfile.TemporaryDirectory(prefix="suds-demo-") as tmp:
-        with progress_bar("Simulating", total=60, enabled=progress, unit="trials") as advance:
-            data = simulate_dataset(tmp, seed=seed, progress=lambda done, total: advance())
+        data = simulate_dataset(tmp, seed=seed, progress=progress)
         summary.simulated_seconds = data.simulated_seconds
         say(
             f"simulated {len(data.tsv_paths)} trials ({data.simulated_seconds / 60:.0f} min of "
