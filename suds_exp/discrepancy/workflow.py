@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from suds_exp.discrepancy.discover import Discovery, DiscoverySettings, discover
+from suds_exp.discrepancy.discover import Constancy, Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
 from suds_exp.discrepancy.errors import DiscrepancyError
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
+from suds_exp.discrepancy.partial import check_named, discover_step
 from suds_exp.discrepancy.replay import (
     ReplaySettings,
     WindowSet,
@@ -123,6 +124,7 @@ class Step:
     correlations: pd.DataFrame | None = None
     example: dict | None = None
     discovery: Discovery | None = None
+    constancy: Constancy | None = None  # the accepted effect's check (`partial.py`)
 
 
 @dataclass
@@ -166,6 +168,8 @@ class DiscrepancyResult:
                     if s.index + 1 < len(self.steps)
                     else None,
                     "gap_closed": s.gap_closed,
+                    # "partial": its strength is not constant (`partial.py`), not the cause
+                    "role": "partial" if s.decision == "partial" else "cause",
                 }
             )
         return out
@@ -339,27 +343,6 @@ def _rmse(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
     return np.sqrt(np.nanmean((sim - meas) ** 2, axis=(0, 1)))
 
 
-def _discover(full, samples, sim, meas, scales, train_ids, opts, rng) -> Discovery:
-    """The sparse correction of the current replay ``sim`` (no new replay)."""
-    from suds_exp.discrepancy.features import feature_library
-
-    X, feats = feature_library(full, samples, sim)
-    return discover(
-        X,
-        feats,
-        sim,
-        meas,
-        scales,
-        full.trial_id,
-        train_ids,
-        full.channels,
-        opts.alpha,
-        opts.fit.min_improvement,
-        opts.discovery,
-        rng,
-    )
-
-
 def run_discrepancy(
     store=None,
     prep: str | int | None = None,
@@ -463,6 +446,7 @@ def run_discrepancy(
     accepted_effects: set[str] = set()
     current = model
     example_k = int(np.flatnonzero(is_test)[0])
+    partial, prev_sim = [], None  # effects found partial (`partial.py`), last replay
     for index in range(opts.max_effects + 1):
         sim = replay(full, [current])[0]
         residual = (sim - meas_all)[..., :3]
@@ -489,6 +473,16 @@ def run_discrepancy(
             f"step {index}: held-out loss {step.test_loss:.4g}, "
             f"rmse vx {step.test_rmse[0]:.3g} mm/s"
         )
+        if prev_sim is not None and steps[-2].accepted is not None:
+            partial += check_named(
+                steps[-2], prev_sim, sim, full, samples, meas_all, scales, train_ids, opts
+            )
+            c = steps[-2].constancy
+            say(
+                f"  {c.effect}: {steps[-2].decision} (a varying strength removes "
+                f"{c.improvement:.0%} of the rest, p {c.p_value:.2g}, {c.varies_with})"
+            )
+        prev_sim = sim
         if len(accepted_effects) >= opts.max_effects:
             step.decision = "max_effects"
             break
@@ -516,7 +510,7 @@ def run_discrepancy(
             step.decision = "none_significant"
             # systematic = the residual's phase profile repeats across independent halves
             step.systematic = systematic_gap(residual, phase_all, full.info, (train_ids, test_ids))
-            if step.systematic[1] < opts.alpha and step.test_loss > opts.gap_floor:
+            if (step.systematic[1] < opts.alpha and step.test_loss > opts.gap_floor) or partial:
                 step.correlations = residual_correlations(
                     samples,
                     residual[is_test],
@@ -524,8 +518,8 @@ def run_discrepancy(
                     full.info[is_test].reset_index(drop=True),
                 )
                 if opts.discover:
-                    step.discovery = _discover(
-                        full, samples, sim, meas_all, scales, train_ids, opts, rng
+                    step.discovery = discover_step(
+                        full, samples, sim, meas_all, scales, train_ids, opts, rng, partial
                     )
                     d = step.discovery
                     say(
@@ -562,7 +556,11 @@ def run_discrepancy(
                 say(f"  re-fitted {r.candidate.label}: {r.value:.4g} {r.ci}")
 
     last = steps[-1]
-    named = [s.accepted.candidate.label for s in steps if s.accepted]
+    named = [
+        s.accepted.candidate.label + (" (partly)" if s.decision == "partial" else "")
+        for s in steps
+        if s.accepted
+    ]
     d = last.discovery
     if d is not None and d.significant:
         outcome = (
