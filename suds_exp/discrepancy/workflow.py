@@ -232,6 +232,8 @@ class DiscrepancyResult:
                     ],
                     "unobservable": s.unobservable,
                     "systematic_p": s.systematic[1],
+                    "varying_strength_p": s.constancy.p_value if s.constancy else None,
+                    "varies_with": s.constancy.varies_with if s.constancy else None,
                 }
                 for s in self.steps
             ],
