@@ -123,12 +123,16 @@ class Discovery:
 
     @property
     def physics(self) -> str:
-        """What the leading term most resembles (`features.PHYSICS`), '' with no term."""
-        lead = self.leading
-        if not lead:
-            return ""
-        fam = next(t.feature.family for t in self.terms if t.feature.name == lead[0])
-        return PHYSICS.get(fam, fam)
+        """What the correction most resembles, '' with no term: the physics
+        (`features.PHYSICS`) whose terms carry the largest total share over all channels.
+        By share, not by the single largest term: one effect shows in several channels
+        (an inertia lags vx, vy and wz alike) and is not outvoted by one large term."""
+        share: dict[str, float] = {}
+        for t in self.terms:
+            if t.feature.family != "constant":
+                name = PHYSICS.get(t.feature.family, t.feature.family)
+                share[name] = share.get(name, 0.0) + t.weight
+        return max(share, key=share.get) if share else ""
 
     def equations(self) -> list[str]:
         """One line per corrected channel, e.g. ``vx += -0.19 [-0.21, -0.17] s * dv_x/dt``."""
