@@ -150,3 +150,31 @@ def test_discovery_recovers_a_term_and_discovers_nothing_in_noise(signal):
     (term,) = [t for t in d.terms if t.channel == "vx"]
     assert term.ci[0] <= 1.0 <= term.ci[1] and term.unit == "mm/s / (mm/s^2)"
     assert d.improvement > 0.5
+
+
+@pytest.mark.parametrize("drift", [0.0, 1.0])
+def test_constancy_flags_an_effect_whose_strength_grows_with_distance(drift):
+    """The remainder after a named effect D: a constant mis-scale of D (plus noise) is
+    absorbed by D itself; a strength growing with distance s is not, and is flagged."""
+    from suds_exp.discrepancy.discover import effect_constancy
+    from suds_exp.discrepancy.features import Feature
+
+    rng = np.random.default_rng(3)
+    n_win, n_s, n_ch = 24, 80, 3
+    D = rng.normal(size=(n_win, n_s, n_ch))
+    s = np.repeat(rng.uniform(0.0, 1.0, size=(n_win, 1)), n_s, axis=1)
+    t = rng.uniform(0.0, 10.0, size=(n_win, n_s))
+    fwd = rng.integers(0, 2, size=(n_win, n_s)).astype(float)
+    Xe = np.stack([D, s[..., None] * D, t[..., None] * D, fwd[..., None] * D], axis=-1)
+    feats = [
+        Feature(n, "-", f)
+        for n, f in [("D", "effect"), ("sD", "distance"), ("tD", "time"), ("fD", "sign")]
+    ]
+    sim = rng.normal(size=(n_win, n_s, n_ch))
+    meas = sim + 0.2 * D + drift * (s[..., None] - 0.5) * D
+    meas = meas + rng.normal(scale=0.3, size=sim.shape)
+    trial_id = np.repeat(np.arange(12), 2)
+    c = effect_constancy(Xe, feats, sim, meas, np.ones(3), trial_id, range(6), 0.01, 0.05)
+    assert c.significant == bool(drift), (c.p_value, c.improvement)
+    if drift:
+        assert c.varies_with == "distance" and c.improvement > 0.3

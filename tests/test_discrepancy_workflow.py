@@ -74,6 +74,8 @@ def test_names_the_hidden_effect_with_an_interval_covering_the_truth(cli_run):
     assert doc["gap_after"] <= 0.5 * doc["gap_before"]
     # nothing else is named once the effect is in the model
     assert [n["effect"] for n in doc["named"]] == ["body_inertia"]
+    # and its strength is constant: named as the cause, not as a partial explanation
+    assert first["role"] == "cause"
 
 
 def test_run_is_stored_in_the_discrepancy_tables(cli_run, inertia_db):
@@ -101,6 +103,13 @@ def test_run_is_stored_in_the_discrepancy_tables(cli_run, inertia_db):
         "SELECT DISTINCT view FROM discrepancy_localisation WHERE run_id = ?", [doc["run_id"]]
     )
     assert set(views.view) == {"condition", "phase", "shape", "time"}
+    checks = store.query_df(
+        "SELECT step, effect, significant, test_loss_constant, test_loss_varying "
+        "FROM discrepancy_constancy WHERE run_id = ?",
+        [doc["run_id"]],
+    )
+    assert checks.step.tolist() == [0] and checks.effect.tolist() == ["body_inertia"]
+    assert not checks.significant.iloc[0] and checks.test_loss_constant.iloc[0] > 0
 
 
 def test_report_page_is_self_contained(cli_run):
@@ -225,6 +234,7 @@ def test_each_hidden_effect_is_named_first(effect, seed, tmp_path):
     run = hidden_effect_run({effect: settings}, seed=seed, workdir=tmp_path, **SWEEP)
     named = run.result.named
     assert named and named[0]["effect"] == effect, run.result.outcome
+    assert named[0]["role"] == "cause", run.result.steps[0].constancy
     lo, hi = named[0]["ci"]
     truth = run.truth(effect)
     assert lo <= truth <= hi, (truth, named[0])

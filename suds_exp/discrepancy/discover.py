@@ -32,7 +32,7 @@ from scipy import stats
 from sklearn.linear_model import orthogonal_mp
 from sklearn.model_selection import GroupKFold
 
-from suds_exp.discrepancy.features import PHYSICS, Feature, channel_unit
+from suds_exp.discrepancy.features import IN_CHANNEL_UNIT, PHYSICS, Feature, channel_unit
 from suds_exp.discrepancy.fit_candidates import trial_losses
 from suds_exp.errors import DiscrepancyError
 
@@ -80,6 +80,12 @@ class Term:
     def unit(self) -> str:
         """Unit of the coefficient: channel unit per feature unit."""
         cu, fu = channel_unit(self.channel), self.feature.unit
+        if IN_CHANNEL_UNIT in fu:
+            # a feature in the channel's own unit: the coefficient carries the rest
+            rest = fu.replace(IN_CHANNEL_UNIT, "").strip()
+            if not rest:
+                return "-"
+            return f"1/({rest[1:]})" if rest.startswith("/") else f"1/({rest})"
         return cu if fu == "-" else f"{cu} / ({fu})"
 
 
@@ -90,6 +96,7 @@ class Discovery:
     channels: tuple[str, ...]
     features: list[Feature]
     coef: np.ndarray  # (n_channels, n_features), physical units; 0 off the support
+    n_shared: int = -1  # the first n_shared features are shared; the rest per channel
     terms: list[Term] = field(default_factory=list)
     cv_terms: dict = field(default_factory=dict)  # channel -> chosen number of terms
     test_trials: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -116,12 +123,16 @@ class Discovery:
 
     @property
     def physics(self) -> str:
-        """What the leading term most resembles (`features.PHYSICS`), '' with no term."""
-        lead = self.leading
-        if not lead:
-            return ""
-        fam = next(t.feature.family for t in self.terms if t.feature.name == lead[0])
-        return PHYSICS.get(fam, fam)
+        """What the correction most resembles, '' with no term: the physics
+        (`features.PHYSICS`) whose terms carry the largest total share over all channels.
+        By share, not by the single largest term: one effect shows in several channels
+        (an inertia lags vx, vy and wz alike) and is not outvoted by one large term."""
+        share: dict[str, float] = {}
+        for t in self.terms:
+            if t.feature.family != "constant":
+                name = PHYSICS.get(t.feature.family, t.feature.family)
+                share[name] = share.get(name, 0.0) + t.weight
+        return max(share, key=share.get) if share else ""
 
     def equations(self) -> list[str]:
         """One line per corrected channel, e.g. ``vx += -0.19 [-0.21, -0.17] s * dv_x/dt``."""
@@ -138,13 +149,19 @@ class Discovery:
             lines.append(f"{ch} ({channel_unit(ch)}) += " + " ".join(parts))
         return lines
 
-    def predict(self, X: np.ndarray) -> np.ndarray:
-        """The correction, (..., n_channels) in the channels' units, from features
-        (..., n_features); NaN features of unused columns do not matter."""
-        used = np.flatnonzero(np.any(self.coef != 0, axis=0))
+    def predict(self, X: np.ndarray, Xc: np.ndarray | None = None) -> np.ndarray:
+        """The correction, (..., n_channels) in the channels' units, from the shared
+        features X (..., n_shared) and the per-channel ones Xc (..., n_channels, n_rest);
+        NaN features of unused columns do not matter."""
+        n = self.coef.shape[1] if self.n_shared < 0 else self.n_shared
+        shared = self.coef[:, :n]
+        used = np.flatnonzero(np.any(shared != 0, axis=0))
         out = np.zeros(X.shape[:-1] + (len(self.channels),))
         if len(used):
-            out = np.einsum("...f,cf->...c", X[..., used], self.coef[:, used])
+            out = out + np.einsum("...f,cf->...c", X[..., used], shared[:, used])
+        rest = self.coef[:, n:]
+        if Xc is not None and np.any(rest != 0):
+            out = out + np.nansum(np.where(rest != 0, Xc, 0.0) * rest, axis=-1)
         return out
 
 
@@ -222,13 +239,15 @@ def discover(
     min_improvement: float,
     settings: DiscoverySettings | None = None,
     rng: np.random.Generator | None = None,
+    Xc: np.ndarray | None = None,
+    channel_feats: list[Feature] = (),
 ) -> Discovery:
     """Fit the sparse correction on training trials and test it on the others.
 
     Parameters
     ----------
     X : array (n_windows, n_samples, n_features)
-        `feature_library` of the windows.
+        `feature_library` of the windows (shared by every channel).
     sim, meas : arrays (n_windows, n_samples, n_channels)
         The current model's replay and the measurement (channels as `replay`).
     scales : array (n_channels,)
@@ -237,26 +256,34 @@ def discover(
     train_trials : ids of the training trials; every other window is held out.
     channels : names of the channels.
     alpha, min_improvement : the held-out test's level and margin (as for candidates).
+    Xc : array (n_windows, n_samples, n_channels, n_rest), optional
+        Features that differ per channel (`features.channel_features`,
+        `features.effect_features`), described by ``channel_feats``.
     """
     started = time.perf_counter()
     s = settings or DiscoverySettings()
     rng = rng or np.random.default_rng(0)
     n_win, n_s, n_f = X.shape
+    channel_feats = list(channel_feats)
+    if Xc is None:
+        Xc = np.zeros((n_win, n_s, len(channels), 0))
+    n_g = Xc.shape[-1]
     is_train = np.isin(trial_id, np.asarray(list(train_trials)))
     groups_all = np.repeat(trial_id, n_s)
-    flat_X = X.reshape(-1, n_f)
     target = ((meas - sim) / scales).reshape(-1, len(channels))
     row_train = np.repeat(is_train, n_s)
-    ok = row_train & np.all(np.isfinite(flat_X), axis=1) & np.all(np.isfinite(target), axis=1)
-    rms = np.sqrt(np.mean(flat_X[ok] ** 2, axis=0))
-    usable = rms > 0
-    Xs = np.where(usable, flat_X / np.where(usable, rms, 1.0), 0.0)
-    coef = np.zeros((len(channels), n_f))
+    coef = np.zeros((len(channels), n_f + n_g))
     terms = []
     chosen = {}
+    all_feats = list(features) + channel_feats
     for c, ch in enumerate(channels):
-        Xc, yc, gc = Xs[ok][:, usable], target[ok, c], groups_all[ok]
-        support_u = _choose_terms(Xc, yc, gc, s)
+        flat_X = np.concatenate([X, Xc[..., c, :]], axis=-1).reshape(-1, n_f + n_g)
+        ok = row_train & np.all(np.isfinite(flat_X), axis=1) & np.isfinite(target[:, c])
+        rms = np.sqrt(np.mean(flat_X[ok] ** 2, axis=0))
+        usable = rms > 0
+        Xs = np.where(usable, flat_X / np.where(usable, rms, 1.0), 0.0)
+        Xc_, yc, gc = Xs[ok][:, usable], target[ok, c], groups_all[ok]
+        support_u = _choose_terms(Xc_, yc, gc, s)
         support = np.flatnonzero(usable)[support_u]
         chosen[ch] = len(support)
         if not len(support):
@@ -267,22 +294,98 @@ def discover(
             to_phys = scales[c] / rms[f]
             coef[c, f] = xi[f] * to_phys
             a, b = sorted((lo[j] * to_phys, hi[j] * to_phys))
-            terms.append(Term(ch, features[f], coef[c, f], (a, b), abs(xi[f])))
-    out = Discovery(tuple(channels), features, coef, terms, chosen)
+            terms.append(Term(ch, all_feats[f], coef[c, f], (a, b), abs(xi[f])))
+    out = Discovery(tuple(channels), all_feats, coef, n_f, terms, chosen)
     test = ~is_train
-    corrected = sim[test] + np.nan_to_num(out.predict(X[test]))
+    corrected = sim[test] + np.nan_to_num(out.predict(X[test], Xc[test]))
     trials, loss = trial_losses(
         np.stack([sim[test], corrected]), meas[test], scales, trial_id[test]
     )
     out.test_trials, out.test_before, out.test_after = trials, loss[0], loss[1]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        d = 1.0 - loss[1] / loss[0]
-    if not terms or len(d) < 2 or not np.all(np.isfinite(d)):
-        out.p_value = 1.0
-    elif np.allclose(d, d[0]):
-        out.p_value = 0.0 if d[0] > min_improvement else 1.0
-    else:
-        out.p_value = float(stats.ttest_1samp(d, min_improvement, alternative="greater").pvalue)
+    out.p_value = _held_out_p(loss[0], loss[1], min_improvement) if terms else 1.0
     out.significant = out.p_value < alpha
     out.seconds = time.perf_counter() - started
     return out
+
+
+def _held_out_p(before: np.ndarray, after: np.ndarray, margin: float) -> float:
+    """One-sided paired t-test over held-out trials that 1 - after / before > margin."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = 1.0 - after / before
+    if len(d) < 2 or not np.all(np.isfinite(d)):
+        return 1.0
+    if np.allclose(d, d[0]):
+        return 0.0 if d[0] > margin else 1.0
+    return float(stats.ttest_1samp(d, margin, alternative="greater").pvalue)
+
+
+@dataclass
+class Constancy:
+    """Is a named effect's strength constant? (`effect_constancy`; losses per held-out
+    trial, of the remainder with the effect's contribution re-scaled by a constant, and
+    with it varying along distance, time and direction.)"""
+
+    effect: str
+    test_before: np.ndarray
+    test_after: np.ndarray
+    p_value: float
+    significant: bool
+    varies_with: str  # family of the largest varying term: distance | time | sign
+
+    @property
+    def improvement(self) -> float:
+        """Fraction of the constant-effect remainder a varying strength removes."""
+        b = float(np.mean(self.test_before))
+        return 1.0 - float(np.mean(self.test_after)) / b if b > 0 else 0.0
+
+
+def effect_constancy(
+    Xe: np.ndarray,
+    features: list[Feature],
+    sim: np.ndarray,
+    meas: np.ndarray,
+    scales: np.ndarray,
+    trial_id: np.ndarray,
+    train_trials,
+    alpha: float,
+    min_improvement: float,
+    effect: str = "",
+) -> Constancy:
+    """Test that a just-named effect has one strength everywhere.
+
+    ``Xe`` (n_windows, n_samples, n_channels, 4) is `features.effect_features` of the
+    effect: its contribution D and D times distance, time and forward-sliding. On the
+    training trials, per channel, the remainder ``meas - sim`` (``sim`` is the replay with
+    the effect) is regressed by least squares once on D alone (a constant re-scaling of
+    the effect: absorbs a slightly mis-fitted parameter) and once on all four. On the
+    held-out trials, the one-sided paired t-test that the varying fit removes more than
+    ``min_improvement`` of the constant fit's loss, at ``alpha``. A significant result
+    means the data want the effect stronger in some parts and weaker in others: the
+    effect mimics something the library does not hold, and is reported as a partial
+    explanation, not as the cause.
+    """
+    n_win, n_s, n_ch, n_e = Xe.shape
+    is_train = np.isin(trial_id, np.asarray(list(train_trials)))
+    row_train = np.repeat(is_train, n_s)
+    target = ((meas - sim) / scales).reshape(-1, n_ch)
+    corr = np.zeros((2, n_win * n_s, n_ch))
+    share = np.zeros(n_e)
+    for c in range(n_ch):
+        Xf = Xe[..., c, :].reshape(-1, n_e) / scales[c]
+        ok = np.all(np.isfinite(Xf), axis=1) & np.isfinite(target[:, c])
+        fit = ok & row_train
+        rms = np.sqrt(np.mean(Xf[fit] ** 2, axis=0))
+        if not fit.any() or rms[0] == 0:
+            continue
+        for k, cols in enumerate((np.array([0]), np.flatnonzero(rms > 0))):
+            b = np.linalg.lstsq(Xf[fit][:, cols], target[fit, c], rcond=None)[0]
+            corr[k, ok, c] = Xf[ok][:, cols] @ b * scales[c]
+            if k == 1:
+                share[cols] += np.abs(b) * rms[cols]
+    corr = corr.reshape(2, n_win, n_s, n_ch)
+    test = ~is_train
+    trials, loss = trial_losses(sim[None, test] + corr[:, test], meas[test], scales, trial_id[test])
+    p = _held_out_p(loss[0], loss[1], min_improvement)
+    varying = share[1:]
+    fam = features[1 + int(np.argmax(varying))].family if varying.any() else ""
+    return Constancy(effect, loss[0], loss[1], p, p < alpha, fam)

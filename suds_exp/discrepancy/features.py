@@ -21,7 +21,22 @@ from scipy.signal import savgol_filter
 
 from suds_exp.discrepancy.replay import WindowSet, window_field
 
-#: Physics a term of each feature family most resembles.
+#: Physics a term of each feature family most resembles. The mapping is the form each
+#: physical effect takes in a first-order correction of a quasi-static model:
+#: - acceleration: momentum makes the body lag its quasi-static velocity,
+#:   v = v_qs - tau dv/dt (`channel_features`' own-channel rate for the body channels,
+#:   or the measured acceleration): inertia;
+#: - rate: a viscous torque opposes the hinge rate, so the flippers lag their
+#:   quasi-static opening, r_p = r_p,qs - tau dr_p/dt (the own-channel rate of the
+#:   passive shape), or the body feels a force in the shape rates: damping;
+#: - distance: a resistance that grows with distance travelled s scales the velocity
+#:   by (1 - k s), a term in s times the velocity or times a named effect: compaction;
+#: - sign: a force that differs sliding forward and backward, max(v_x, 0) or a named
+#:   effect gated by the sliding direction: asymmetric drag;
+#: - velocity: a term in the model's own velocity rescales every drag: drag scaling;
+#: - time: a slow change along the trial not tied to distance: drift;
+#: - shape, product: a force that depends on where in the gait the body is, the generic
+#:   periodic correction that names no mechanism.
 PHYSICS: dict[str, str] = {
     "acceleration": "inertia",
     "distance": "compaction",
@@ -32,6 +47,7 @@ PHYSICS: dict[str, str] = {
     "shape": "shape-dependent force",
     "product": "shape-dependent force",
     "constant": "offset",
+    "effect": "the named effect's own scale",
 }
 
 #: Units of the replayed channels (vx, vy, wz, then passive-shape coordinates).
@@ -41,6 +57,10 @@ CHANNEL_UNITS = {"vx": "mm/s", "vy": "mm/s", "wz": "rad/s"}
 def channel_unit(channel: str) -> str:
     """Unit of a compared channel (r_p coordinates are mm)."""
     return CHANNEL_UNITS.get(channel, "mm")
+
+
+#: Unit suffix of a channel-specific feature that carries its channel's own unit.
+IN_CHANNEL_UNIT = "[channel]"
 
 
 @dataclass(frozen=True)
@@ -179,3 +199,84 @@ def feature_library(
     X = np.stack([x for _, x in cols], axis=-1)
     X[~np.isfinite(t)] = np.nan
     return X, features
+
+
+def channel_features(windows: WindowSet, sim: np.ndarray) -> tuple[np.ndarray, list[Feature]]:
+    """Features that differ per channel: the first-order lag of the channel itself.
+
+    A channel that lags its quasi-static value with time constant tau reads
+    ``x = x_model - tau dx_model/dt`` to first order. For the body velocity that lag is
+    momentum (inertia); for the passive shape it is the flippers lagging their
+    quasi-static opening, which is what a viscous hinge does (damping). So the model's own
+    rate of each channel is one feature per physics, zero on the channels it does not
+    apply to.
+
+    Returns
+    -------
+    Xc : array (n_windows, n_samples, n_channels, 2)
+    features : the two `Feature` s (coefficients in s)
+    """
+    t = window_field(windows, "t")
+    rate = _rate(sim, t)
+    n_ch = sim.shape[-1]
+    body = np.arange(n_ch) < 3
+    Xc = np.zeros(sim.shape + (2,))
+    Xc[..., body, 0] = rate[..., body]
+    Xc[..., ~body, 1] = rate[..., ~body]
+    Xc[~np.isfinite(t)] = np.nan
+    unit = f"{IN_CHANNEL_UNIT}/s"
+    return Xc, [
+        Feature("d/dt(own velocity)^model", unit, "acceleration"),
+        Feature("d/dt(own r_p)^model", unit, "rate"),
+    ]
+
+
+def effect_features(
+    windows: WindowSet, samples: pd.DataFrame, sim: np.ndarray, delta: np.ndarray, label: str
+) -> tuple[np.ndarray, list[Feature]]:
+    """Does a named effect's strength vary? Its contribution times distance, time, direction.
+
+    ``delta`` is what the named effect adds to every channel (the replay with it minus
+    the replay without it, same shape as ``sim``). A physical constant has the same
+    strength everywhere; an effect that only mimics the real one is too weak in some
+    parts of the data and too strong in others. The three covariates are the ones a
+    constant drag/inertia parameter could physically depend on: distance travelled (a
+    bed that compacts), time in the trial (drift: warming, wear) and the direction the
+    body slides (drag that differs forward and backward). ``delta`` itself is in the set
+    so that a slightly mis-fitted but constant parameter is absorbed there.
+
+    Returns
+    -------
+    Xc : array (n_windows, n_samples, n_channels, 4)
+    features : `Feature` s named after ``label`` (coefficients in 1, 1/m, 1/s, 1)
+    """
+    t = window_field(windows, "t")
+    dist, t_trial = _distance_and_time(windows, samples)
+    fwd = (sim[..., :1] > 0).astype(float)
+    Xc = np.stack(
+        [delta, dist[..., None] * delta, t_trial[..., None] * delta, fwd * delta], axis=-1
+    )
+    Xc[~np.isfinite(t)] = np.nan
+    d = f"D[{label}]"
+    return Xc, [
+        Feature(d, IN_CHANNEL_UNIT, "effect"),
+        Feature(f"s*{d}", f"m {IN_CHANNEL_UNIT}", "distance"),
+        Feature(f"t*{d}", f"s {IN_CHANNEL_UNIT}", "time"),
+        Feature(f"[v_x>0]*{d}", IN_CHANNEL_UNIT, "sign"),
+    ]
+
+
+def _distance_and_time(windows: WindowSet, samples: pd.DataFrame):
+    """Distance travelled (m) and time in the trial (s) at every window sample."""
+    t = window_field(windows, "t")
+    per = _trial_arrays(samples)
+    dist = np.full(t.shape, np.nan)
+    t_trial = np.full(t.shape, np.nan)
+    for k, tid in enumerate(windows.trial_id):
+        tr = per[int(tid)]
+        ok = np.isfinite(t[k])
+        tt = tr["t"].to_numpy(float)
+        idx = np.clip(np.searchsorted(tt, t[k, ok] - 1e-9), 0, len(tt) - 1)
+        dist[k, ok] = tr["dist_m"].to_numpy(float)[idx]
+        t_trial[k, ok] = tt[idx] - tt[0]
+    return dist, t_trial

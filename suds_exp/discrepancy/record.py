@@ -157,6 +157,22 @@ def _record_discoveries(store, conn, run_id: int, result) -> None:
                     "weight": _num(t.weight),
                 }
             )
+    checks = [
+        {
+            "run_id": run_id,
+            "step": s.index,
+            "effect": c.effect,
+            "significant": bool(c.significant),
+            "p_value": _num(c.p_value),
+            "test_loss_constant": _num(np.mean(c.test_before)),
+            "test_loss_varying": _num(np.mean(c.test_after)),
+            "varies_with": c.varies_with,
+        }
+        for s in result.steps
+        if (c := getattr(s, "constancy", None)) is not None
+    ]
+    if checks:
+        store.insert_df(conn, "discrepancy_constancy", pd.DataFrame(checks))
     if runs:
         store.insert_df(conn, "discrepancy_discoveries", pd.DataFrame(runs))
     if terms:

@@ -39,6 +39,9 @@ def _steps_table(result) -> pd.DataFrame:
                 "p_adjusted": a.p_adjusted if a else np.nan,
                 "gap_closed": s.gap_closed if s.gap_closed is not None else np.nan,
                 "systematic_p": s.systematic[1],
+                # the named effect's check (partial.py): is its strength constant?
+                "varying_strength_p": s.constancy.p_value if s.constancy else np.nan,
+                "varies_with": s.constancy.varies_with if s.constancy else "",
             }
         )
     return pd.DataFrame(rows)
@@ -215,7 +218,7 @@ def _discovery_parts(result, out: Path) -> list[str]:
     (out / "correction.md").write_text(_md(table) if not table.empty else "(no term)\n")
     _fig_discovery(d, out / "discovery.png")
     verdict = "added to the model" if d.significant else "not added (held-out test failed)"
-    return [
+    return _shares(result) + [
         "<h2>Learned correction (no named effect explains the gap)</h2>",
         f"<p>{html.escape(verdict)}: held-out loss {np.mean(d.test_before):.4g} -> "
         f"{np.mean(d.test_after):.4g} ({d.improvement:.0%} closed, p = {d.p_value:.2g}); "
@@ -226,6 +229,29 @@ def _discovery_parts(result, out: Path) -> list[str]:
         "<h3>Held-out loss per trial, with and without the correction</h3>"
         "<img src='discovery.png' width='100%'>",
     ]
+
+
+def _shares(result) -> list[str]:
+    """How much of the held-out gap each part closed: the effects named as partial
+    explanations, then the learned correction (the form-mismatch case)."""
+    partial = [s for s in result.steps if s.decision == "partial"]
+    if not partial:
+        return []
+    d = result.steps[-1].discovery
+    g0 = result.gap_before
+    parts = [
+        f"{s.accepted.candidate.label} (its strength varies with {s.constancy.varies_with}, "
+        f"p = {s.constancy.p_value:.2g}: a partial explanation, not the cause) closed "
+        f"{s.gap_closed:.0%} of the gap it was given"
+        for s in partial
+    ]
+    rest = (
+        f"the learned correction closed {d.improvement:.0%} of what remained"
+        if d is not None and d.significant
+        else "what remained is unexplained"
+    )
+    total = 1 - result.gap_after_correction / g0 if g0 > 0 else 0.0
+    return [f"<p>{html.escape('; '.join(parts) + '; ' + rest)}; together {total:.0%}.</p>"]
 
 
 def write_report(result, out: Path) -> Path:

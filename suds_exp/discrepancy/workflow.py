@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from suds_exp.discrepancy.discover import Discovery, DiscoverySettings, discover
+from suds_exp.discrepancy.discover import Constancy, Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
 from suds_exp.discrepancy.fit_candidates import (
     CandidateResult,
@@ -28,6 +28,7 @@ from suds_exp.discrepancy.fit_candidates import (
     trial_losses,
 )
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
+from suds_exp.discrepancy.partial import check_named, discover_step
 from suds_exp.discrepancy.replay import (
     ReplaySettings,
     WindowSet,
@@ -125,6 +126,7 @@ class Step:
     correlations: pd.DataFrame | None = None
     example: dict | None = None
     discovery: Discovery | None = None
+    constancy: Constancy | None = None  # the accepted effect's check (`partial.py`)
 
 
 @dataclass
@@ -168,6 +170,8 @@ class DiscrepancyResult:
                     if s.index + 1 < len(self.steps)
                     else None,
                     "gap_closed": s.gap_closed,
+                    # "partial": its strength is not constant (`partial.py`), not the cause
+                    "role": "partial" if s.decision == "partial" else "cause",
                 }
             )
         return out
@@ -230,6 +234,8 @@ class DiscrepancyResult:
                     ],
                     "unobservable": s.unobservable,
                     "systematic_p": s.systematic[1],
+                    "varying_strength_p": s.constancy.p_value if s.constancy else None,
+                    "varies_with": s.constancy.varies_with if s.constancy else None,
                 }
                 for s in self.steps
             ],
@@ -340,27 +346,6 @@ def _scales(meas: np.ndarray) -> np.ndarray:
 
 def _rmse(sim: np.ndarray, meas: np.ndarray) -> np.ndarray:
     return np.sqrt(np.nanmean((sim - meas) ** 2, axis=(0, 1)))
-
-
-def _discover(full, samples, sim, meas, scales, train_ids, opts, rng) -> Discovery:
-    """The sparse correction of the current replay ``sim`` (no new replay)."""
-    from suds_exp.discrepancy.features import feature_library
-
-    X, feats = feature_library(full, samples, sim)
-    return discover(
-        X,
-        feats,
-        sim,
-        meas,
-        scales,
-        full.trial_id,
-        train_ids,
-        full.channels,
-        opts.alpha,
-        opts.fit.min_improvement,
-        opts.discovery,
-        rng,
-    )
 
 
 @dataclass
@@ -531,14 +516,25 @@ def try_candidates(
             r.train_before = float(base_train[0].mean())
 
 
-def explain_gap(step: Step, w: Windows, sim: np.ndarray, opts: DiscrepancyOptions, rng, say):
+def explain_gap(
+    step: Step,
+    w: Windows,
+    sim: np.ndarray,
+    opts: DiscrepancyOptions,
+    rng,
+    say,
+    partial: list | None = None,
+):
     """No candidate is significant: test whether the gap is systematic and, if it is and
-    above ``gap_floor``, correlate it with the signals and try a learned correction."""
+    above ``gap_floor`` (or an effect named earlier was only ``partial``), correlate it
+    with the signals and try a learned correction (with the partial effects' features)."""
+    partial = partial or []
     step.decision = "none_significant"
     residual = (sim - w.measured)[..., :3]
     # systematic = the residual's phase profile repeats across independent halves
     step.systematic = systematic_gap(residual, w.phase, w.full.info, (w.train_ids, w.test_ids))
-    if step.systematic[1] >= opts.alpha or step.test_loss <= opts.gap_floor:
+    gap = step.systematic[1] < opts.alpha and step.test_loss > opts.gap_floor
+    if not (gap or partial):
         return
     step.correlations = residual_correlations(
         w.samples,
@@ -548,8 +544,8 @@ def explain_gap(step: Step, w: Windows, sim: np.ndarray, opts: DiscrepancyOption
     )
     if not opts.discover:
         return
-    step.discovery = d = _discover(
-        w.full, w.samples, sim, w.measured, w.scales, w.train_ids, opts, rng
+    step.discovery = d = discover_step(
+        w.full, w.samples, sim, w.measured, w.scales, w.train_ids, opts, rng, partial
     )
     say(
         f"  discovered correction ({'added' if d.significant else 'not added'}, "
@@ -595,7 +591,11 @@ def accept(
 def outcome(steps: list[Step]) -> str:
     """One sentence on what the run found (the last step's decision and the names)."""
     last = steps[-1]
-    named = [s.accepted.candidate.label for s in steps if s.accepted]
+    named = [
+        s.accepted.candidate.label + (" (partly)" if s.decision == "partial" else "")
+        for s in steps
+        if s.accepted
+    ]
     d = last.discovery
     if d is not None and d.significant:
         return (
@@ -621,6 +621,7 @@ def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
     final model."""
     steps: list[Step] = []
     current = model
+    partial, prev_sim = [], None  # effects found partial (`partial.py`), last replay
     for index in range(opts.max_effects + 1):
         step, sim = gap_step(w, current, index, rng)
         if steps:
@@ -631,6 +632,16 @@ def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
             f"step {index}: held-out loss {step.test_loss:.4g}, "
             f"rmse vx {step.test_rmse[0]:.3g} mm/s"
         )
+        if prev_sim is not None and steps[-2].accepted is not None:
+            partial += check_named(
+                steps[-2], prev_sim, sim, w.full, w.samples, w.measured, w.scales, w.train_ids, opts
+            )
+            c = steps[-2].constancy
+            say(
+                f"  {c.effect}: {steps[-2].decision} (a varying strength removes "
+                f"{c.improvement:.0%} of the rest, p {c.p_value:.2g}, {c.varies_with})"
+            )
+        prev_sim = sim
         named = {s.accepted.candidate.effect for s in steps if s.accepted}
         if len(named) >= opts.max_effects:
             step.decision = "max_effects"
@@ -638,7 +649,7 @@ def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
         try_candidates(step, w, opts, named, rng, say)
         significant = [r for r in step.candidates if r.significant]
         if not significant:
-            explain_gap(step, w, sim, opts, rng, say)
+            explain_gap(step, w, sim, opts, rng, say, partial)
             break
         best = max(significant, key=lambda r: r.improvement)
         current = accept(step, best, steps[:-1], w, opts, rng, say)

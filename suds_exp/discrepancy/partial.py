@@ -1,0 +1,98 @@
+"""Cause or partial explanation? The check every named effect passes after it is added.
+
+A library candidate can be significant without being the missing physics: when the real
+effect is not in the library, the nearest candidate often mimics part of it (a constant
+drag scale mimics a drag that grows with distance travelled). Such a candidate is
+recognised by its strength not being constant: the data want it stronger in some parts
+and weaker in others. After an effect is added, the next replay gives its contribution
+D (replay with it minus replay without it, no extra replay) and
+`discover.effect_constancy` tests on held-out trials whether letting D vary with
+distance, time or sliding direction removes a material part of what remains. If it does,
+the effect is kept in the model but reported as a *partial* explanation (step decision
+``partial``), the remaining gap counts as unexplained by the library, and the learned
+correction is fitted to it with D and its variations among the features, so the report
+says how much each part closed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.discrepancy.discover import Discovery, discover, effect_constancy
+from suds_exp.discrepancy.features import channel_features, effect_features, feature_library
+from suds_exp.discrepancy.replay import WindowSet
+
+
+def check_named(
+    step,
+    sim_before: np.ndarray,
+    sim_after: np.ndarray,
+    full: WindowSet,
+    samples: pd.DataFrame,
+    meas: np.ndarray,
+    scales: np.ndarray,
+    train_ids,
+    opts,
+) -> list[tuple[np.ndarray, list]]:
+    """Test the effect ``step`` accepted; set ``step.constancy`` and, when its strength
+    is not constant, ``step.decision = "partial"``.
+
+    ``sim_before`` / ``sim_after``: the full-rate replays (n_windows, n_samples,
+    n_channels) without and with the effect. Returns ``[(Xe, features)]`` for the learned
+    correction when the effect is partial, else ``[]``.
+    """
+    label = step.accepted.candidate.label
+    Xe, feats = effect_features(full, samples, sim_after, sim_after - sim_before, label)
+    step.constancy = effect_constancy(
+        Xe,
+        feats,
+        sim_after,
+        meas,
+        scales,
+        full.trial_id,
+        train_ids,
+        opts.alpha,
+        opts.fit.min_improvement,
+        label,
+    )
+    if not step.constancy.significant:
+        return []
+    step.decision = "partial"
+    return [(Xe, feats)]
+
+
+def discover_step(
+    full: WindowSet,
+    samples: pd.DataFrame,
+    sim: np.ndarray,
+    meas: np.ndarray,
+    scales: np.ndarray,
+    train_ids,
+    opts,
+    rng: np.random.Generator,
+    partial: list[tuple[np.ndarray, list]] = (),
+) -> Discovery:
+    """The learned correction of the current replay ``sim`` (no new replay): the shared
+    `feature_library`, each channel's own lag (`channel_features`) and, for every effect
+    found partial, its contribution and its variations (`effect_features`)."""
+    X, feats = feature_library(full, samples, sim)
+    blocks = [channel_features(full, sim)] + list(partial)
+    Xc = np.concatenate([b[0] for b in blocks], axis=-1)
+    cfeats = [f for b in blocks for f in b[1]]
+    return discover(
+        X,
+        feats,
+        sim,
+        meas,
+        scales,
+        full.trial_id,
+        train_ids,
+        full.channels,
+        opts.alpha,
+        opts.fit.min_improvement,
+        opts.discovery,
+        rng,
+        Xc,
+        cfeats,
+    )
