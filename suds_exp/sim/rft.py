@@ -583,6 +583,69 @@ def _servo_rate(err, load, h, p):
 
 
 @njit(cache=True)
+def _bed_weights(w_eff, geo, bed_k, scale, half_var, has_bed, X, Y, TH, lref, w_bed):
+    """Each element's drag weight on the trial's bed, into ``w_bed`` (n_el,): ``w_eff``
+    times the packing ``scale`` and the random field (modes ``bed_k``, see bed.py) at the
+    element's world position (body pose X, Y mm, TH rad; ``geo`` in units of lref)."""
+    n_el = w_eff.shape[0]
+    if not has_bed:
+        for e in range(n_el):
+            w_bed[e] = w_eff[e]
+        return
+    if half_var == 0.0:
+        # a uniform bed (packing only): no field to evaluate
+        for e in range(n_el):
+            w_bed[e] = w_eff[e] * scale
+        return
+    cth = math.cos(TH)
+    sth = math.sin(TH)
+    for e in range(n_el):
+        if w_eff[e] == 0.0:
+            continue
+        wx_ = X + lref * (cth * geo[e, 0] - sth * geo[e, 1])
+        wy_ = Y + lref * (sth * geo[e, 0] + cth * geo[e, 1])
+        gsum = 0.0
+        for m in range(bed_k.shape[0]):
+            gsum += bed_k[m, 3] * math.cos(bed_k[m, 0] * wx_ + bed_k[m, 1] * wy_ + bed_k[m, 2])
+        w_bed[e] = w_eff[e] * scale * math.exp(gsum - half_var)
+
+
+@njit(cache=True)
+def _se2_step(X, Y, TH, wx, wy, wt):
+    """Move the world pose (X, Y mm, TH rad) by the SE(2) exponential of the body-frame
+    displacement (wx, wy mm, wt rad); returns the new pose and the distance moved (mm)."""
+    if abs(wt) > 1e-9:
+        sa = math.sin(wt) / wt
+        ca = (1.0 - math.cos(wt)) / wt
+    else:
+        sa = 1.0 - wt * wt / 6.0
+        ca = 0.5 * wt
+    lx = sa * wx - ca * wy
+    ly = ca * wx + sa * wy
+    cth = math.cos(TH)
+    sth = math.sin(TH)
+    return (
+        X + (cth * lx - sth * ly),
+        Y + (sth * lx + cth * ly),
+        TH + wt,
+        math.sqrt(wx * wx + wy * wy),
+    )
+
+
+@njit(cache=True)
+def _advance_flippers(x, s, h, amax, held, ang, uprev):
+    """Free flippers over one step h (s): rates x[3:7] * s (rad/s; zero while held on a
+    stop), angles clipped to the stops [0, amax]; updates ang, uprev and held."""
+    for i in range(4):
+        u = x[3 + i] * s
+        if held[i]:
+            u = 0.0
+        ang[i] = min(max(ang[i] + h * u, 0.0), amax)
+        uprev[i] = u
+        held[i] = held[i] and (ang[i] <= 1e-9 or ang[i] >= amax - 1e-9)
+
+
+@njit(cache=True)
 def run_trials(
     phi,
     n_steps,
@@ -720,27 +783,9 @@ def run_trials(
                     fl_side,
                     geo,
                 )
-                if has_bed and half_var == 0.0:
-                    # a uniform bed (packing only): no field to evaluate
-                    for e in range(n_el):
-                        w_bed[e] = w_eff[e] * bed_scale[k]
-                elif has_bed:
-                    cth = math.cos(TH)
-                    sth = math.sin(TH)
-                    for e in range(n_el):
-                        if w_eff[e] == 0.0:
-                            continue
-                        wx_ = X + lref * (cth * geo[e, 0] - sth * geo[e, 1])
-                        wy_ = Y + lref * (sth * geo[e, 0] + cth * geo[e, 1])
-                        gsum = 0.0
-                        for m in range(n_modes):
-                            gsum += bed[k, m, 3] * math.cos(
-                                bed[k, m, 0] * wx_ + bed[k, m, 1] * wy_ + bed[k, m, 2]
-                            )
-                        w_bed[e] = w_eff[e] * bed_scale[k] * math.exp(gsum - half_var)
-                else:
-                    for e in range(n_el):
-                        w_bed[e] = w_eff[e]
+                _bed_weights(
+                    w_eff, geo, bed[k], bed_scale[k], half_var, has_bed, X, Y, TH, lref, w_bed
+                )
                 # linear predictor of the body twist from the last two solves
                 for i in range(3):
                     xo = x[i]
@@ -767,32 +812,10 @@ def run_trials(
                 v_prev0 += relax * (qs0 - v_prev0)
                 v_prev1 += relax * (qs1 - v_prev1)
                 v_prev2 += relax * (qs2 - v_prev2)
-                # SE(2) exponential of the body twist over h
-                wx = v_prev0 * h
-                wy = v_prev1 * h
-                wt = v_prev2 * h
-                if abs(wt) > 1e-9:
-                    sa = math.sin(wt) / wt
-                    ca = (1.0 - math.cos(wt)) / wt
-                else:
-                    sa = 1.0 - wt * wt / 6.0
-                    ca = 0.5 * wt
-                lx = sa * wx - ca * wy
-                ly = ca * wx + sa * wy
-                cth = math.cos(TH)
-                sth = math.sin(TH)
-                X += cth * lx - sth * ly
-                Y += sth * lx + cth * ly
-                TH += wt
-                dist += math.sqrt(wx * wx + wy * wy) / lref
-                for i in range(4):
-                    if mode == FL_FREE:
-                        u = x[3 + i] * s
-                        if held[i]:
-                            u = 0.0
-                        ang[i] = min(max(ang[i] + h * u, 0.0), amax)
-                        uprev[i] = u
-                        held[i] = held[i] and (ang[i] <= 1e-9 or ang[i] >= amax - 1e-9)
+                X, Y, TH, moved = _se2_step(X, Y, TH, v_prev0 * h, v_prev1 * h, v_prev2 * h)
+                dist += moved / lref
+                if mode == FL_FREE:
+                    _advance_flippers(x, s, h, amax, held, ang, uprev)
                 sum0 += v_prev0
                 sum1 += v_prev1
                 sum2 += v_prev2
