@@ -646,6 +646,41 @@ def _advance_flippers(x, s, h, amax, held, ang, uprev):
 
 
 @njit(cache=True)
+def _start_trial(p, el_w, el_part, ang0_k, w_eff, ang, held, uprev, x, xlast):
+    """A trial's initial state: element weights ``w_eff`` (flippers removed when absent),
+    flipper angles ``ang`` (rad; free ones clipped to the stops, else the locked opening),
+    whether each is ``held`` on a stop, zero flipper rates ``uprev`` and solver guesses."""
+    amax = p[P_AMAX]
+    mode = int(p[P_FLMODE])
+    for e in range(el_w.shape[0]):
+        w_eff[e] = el_w[e]
+        if el_part[e] >= 3 and mode == FL_ABSENT:
+            w_eff[e] = 0.0
+    for i in range(4):
+        if mode == FL_FREE:
+            ang[i] = min(max(ang0_k[i], 0.0), amax)
+        else:
+            ang[i] = p[P_FLLOCK]
+        held[i] = mode != FL_FREE or ang[i] <= 1e-9 or ang[i] >= amax - 1e-9
+        uprev[i] = 0.0
+    for i in range(x.shape[0]):
+        x[i] = 0.0
+        xlast[i] = 0.0
+
+
+@njit(cache=True)
+def _flipper_midpoints(ang, uprev, held, h, amax, mode, amid):
+    """The flipper angles (rad) at the middle of a step h (s), into ``amid``: free ones
+    moved half a step at their last rate within the stops; held or locked ones stay."""
+    for i in range(4):
+        amid[i] = min(max(ang[i] + 0.5 * h * uprev[i], 0.0), amax)
+        if mode != FL_FREE:
+            amid[i] = ang[i]
+        if held[i] and mode == FL_FREE:
+            amid[i] = ang[i]
+
+
+@njit(cache=True)
 def run_trials(
     phi,
     n_steps,
@@ -706,29 +741,15 @@ def run_trials(
         h = dt / nsub
         relax = 1.0 if tau <= 0.0 else 1.0 - math.exp(-h / tau)
         lp = 1.0 - math.exp(-h / SERVO_LOAD_TAU)
-        for e in range(n_el):
-            w_eff[e] = el_w[e]
-            if el_part[e] >= 3 and mode == FL_ABSENT:
-                w_eff[e] = 0.0
+        _start_trial(p, el_w, el_part, ang0[k], w_eff, ang, held, uprev, x, xlast)
         X, Y, TH = pose0[k, 0], pose0[k, 1], pose0[k, 2]
-        for i in range(4):
-            if mode == FL_FREE:
-                ang[i] = min(max(ang0[k, i], 0.0), amax)
-            else:
-                ang[i] = p[P_FLLOCK]
-            held[i] = mode != FL_FREE or ang[i] <= 1e-9 or ang[i] >= amax - 1e-9
-            uprev[i] = 0.0
-        for i in range(N_UNKNOWN):
-            x[i] = 0.0
-            xlast[i] = 0.0
         servo = p[P_SGAIN] > 0.0
         r1, r2 = phi[k, 0, 0], phi[k, 0, 1]
         load1, load2 = 0.0, 0.0
         phi_out[k, 0, 0] = r1
         phi_out[k, 0, 1] = r2
-        n_modes = bed.shape[1]
-        half_var = 0.0
-        for m in range(n_modes):
+        half_var = 0.0  # the variance of the field's log / 2 (bed.py)
+        for m in range(bed.shape[1]):
             half_var += 0.25 * bed[k, m, 3] * bed[k, m, 3]
         has_bed = half_var > 0.0 or bed_scale[k] != 1.0
         v_prev0, v_prev1, v_prev2 = 0.0, 0.0, 0.0
@@ -762,12 +783,7 @@ def run_trials(
                 d1 = (b1 - a1) / h
                 d2 = (b2 - a2) / h
                 s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
-                for i in range(4):
-                    amid[i] = min(max(ang[i] + 0.5 * h * uprev[i], 0.0), amax)
-                    if mode != FL_FREE:
-                        amid[i] = ang[i]
-                    if held[i] and mode == FL_FREE:
-                        amid[i] = ang[i]
+                _flipper_midpoints(ang, uprev, held, h, amax, mode, amid)
                 _element_geometry(
                     0.5 * (a1 + b1),
                     0.5 * (a2 + b2),
@@ -820,14 +836,11 @@ def run_trials(
                 sum1 += v_prev1
                 sum2 += v_prev2
             m0, m1, m2 = sum0 / nsub, sum1 / nsub, sum2 / nsub
-            if f == 0:
-                vel[k, 0, 0] = m0
-                vel[k, 0, 1] = m1
-                vel[k, 0, 2] = m2
-            else:
-                vel[k, f, 0] = 0.5 * (last0 + m0)
-                vel[k, f, 1] = 0.5 * (last1 + m1)
-                vel[k, f, 2] = 0.5 * (last2 + m2)
+            # the twist centred on frame f: mean of the frame intervals either side
+            w = 1.0 if f == 0 else 0.5
+            vel[k, f, 0] = m0 if f == 0 else w * (last0 + m0)
+            vel[k, f, 1] = m1 if f == 0 else w * (last1 + m1)
+            vel[k, f, 2] = m2 if f == 0 else w * (last2 + m2)
             last0, last1, last2 = m0, m1, m2
             phi_out[k, f + 1, 0] = r1 if servo else phi[k, f + 1, 0]
             phi_out[k, f + 1, 1] = r2 if servo else phi[k, f + 1, 1]
