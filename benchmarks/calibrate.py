@@ -50,7 +50,7 @@ from suds_exp.analysis.queries import load_results  # noqa: E402
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.ingest import ingest_paths  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
-from suds_exp.sim import SimConfig, set_effect, simulate_dataset  # noqa: E402
+from suds_exp.sim import SimConfig, apply_effects, simulate_dataset  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 #: The variability effects of issue 17 at the values tried first (off in the nominal
@@ -85,10 +85,7 @@ def search_grid() -> dict[str, list[str]]:
 
 
 def build(items: list[str]) -> SimConfig:
-    cfg = SimConfig()
-    for item in items:
-        cfg = set_effect(cfg, item)
-    return cfg
+    return apply_effects(SimConfig(), items, param="--set")
 
 
 def phase_explained(store: Store, prep: str) -> dict[str, float]:

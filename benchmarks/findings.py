@@ -50,11 +50,9 @@ def prepare(db: Path, seed: int, effects: list[str] = ()) -> str:
     preprocess it (idempotent); returns the preprocessing version's name."""
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
-    from suds_exp.sim import SimConfig, set_effect, simulate_dataset
+    from suds_exp.sim import SimConfig, apply_effects, simulate_dataset
 
-    cfg = SimConfig()
-    for item in effects:
-        cfg = set_effect(cfg, item)
+    cfg = apply_effects(SimConfig(), effects, param="--set")
 
     store = Store(db)
     store.upgrade()

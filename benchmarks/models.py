@@ -304,9 +304,7 @@ def main():
     ap.add_argument("--boots", type=int, default=3)
     ap.add_argument("--data", choices=("sim", "synthetic"), default="sim")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument(
-        "--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation", "curve")
-    )
+    ap.add_argument("--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation", "curve"))
     args = ap.parse_args()
     conditions = [("O", 0.5), ("O", 1.0), ("O", 1 / 3), ("D+", 0.5)]
     t0 = time.perf_counter()

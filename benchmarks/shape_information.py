@@ -31,7 +31,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from suds_exp.sim import SimConfig, plan_trials, set_effect, simulate_trials  # noqa: E402
+from suds_exp.sim import SimConfig, apply_effects, plan_trials, simulate_trials  # noqa: E402
 
 
 def basis(phase: np.ndarray, order: int, x: np.ndarray | None = None) -> np.ndarray:
@@ -86,9 +86,7 @@ def main() -> None:
     ap.add_argument("--order", type=int, default=3, help="Fourier order in the phase")
     ap.add_argument("--set", nargs="*", default=[], help="effects, EFFECT.PARAM=VALUE")
     args = ap.parse_args()
-    cfg = SimConfig()
-    for item in args.set:
-        cfg = set_effect(cfg, item)
+    cfg = apply_effects(SimConfig(), args.set, param="--set")
     print(f"setting: {' '.join(args.set) or 'nominal'}; gait {args.gait}, seed {args.seed}")
     print("| Hz | mean stroke (rad) | phase | r_a | r_a+flippers | phase / r_a | r_a / (r_a+fl) |")
     print("|---|---|---|---|---|---|---|")

@@ -31,6 +31,7 @@ from suds_exp.sim import (  # noqa: E402
     FREQUENCIES_HZ,
     GAITS,
     SimConfig,
+    apply_effects,
     plan_trials,
     set_effect,
     simulate_dataset,
@@ -40,9 +41,7 @@ from suds_exp.sim import (  # noqa: E402
 
 
 def speed(runs: int, effects: list[str] = ()) -> None:
-    cfg = SimConfig()
-    for item in effects:
-        cfg = set_effect(cfg, item)
+    cfg = apply_effects(SimConfig(), effects, param="--set")
     specs = plan_trials()
     simulate_trials(specs[:1], cfg)  # compile / load the numba cache
     cpu, wall = [], []

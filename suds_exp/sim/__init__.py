@@ -27,6 +27,7 @@ from suds_exp.sim.dataset import (
 )
 from suds_exp.sim.effects import (
     EFFECT_NAMES,
+    apply_effects,
     effect_library,
     parse_effect,
     set_effect,
@@ -47,6 +48,7 @@ __all__ = [
     "SimConfig",
     "SimulatedDataset",
     "actuate",
+    "apply_effects",
     "compare_with_hatton",
     "config_from_dict",
     "effect_library",
