@@ -463,11 +463,12 @@ BASELINES: dict[str, tuple] = {
     # docs: Adam "works pretty well on relatively large datasets (thousands of training
     # samples or more) ... For small datasets, however, 'lbfgs' can converge faster and
     # perform better"; a campaign trains on 100-4800 samples. Measured against the
-    # former Adam default (lr 1e-3, early stopping on 10 %, seeds 0 and 1, 30 training
-    # cycles, benchmarks/models.py and README, Learner survey): MLP CPU 0.84 vs 0.71 s,
-    # held-out RMSE vx lower on every test condition; MLP+SUDS CPU 0.86 vs 2.00 s, RMSE
-    # equal at the training condition (3.54 vs 3.50 mm/s) and lower off it. L-BFGS has no
-    # early stopping (scikit-learn ignores it for that solver), so the budget is the rule.
+    # former Adam default (lr 1e-3, early stopping on 10 %) by benchmarks/models.py
+    # section 4 (30 training cycles, seeds 0 and 1; README, Speed of the survey
+    # learners): MLP+SUDS half the CPU (1.01 vs 2.06 s), the same held-out error on its
+    # training condition and lower on three others; the MLP lower error on all four but
+    # twice the CPU (0.98 vs 0.52 s). L-BFGS has no early stopping (scikit-learn ignores
+    # it for that solver): its 200-iteration budget (scikit-learn's default) is the rule.
     "MLP": (
         _mlp,
         {
