@@ -137,6 +137,10 @@ def main() -> None:
         )
         summary = run_campaign(store, name, options, samples=samples, jobs=args.jobs)
         print(f"{name}: {summary.message()}", flush=True)
+        if summary.interrupted:
+            # run_campaign turned Ctrl-C / SIGTERM into a clean stop of this campaign; the
+            # user meant the whole run, so neither the next campaigns nor the report
+            sys.exit(130)
     results = pd.concat(
         [load_results(store, n, columns=SURVEY_COLUMNS) for n in names], ignore_index=True
     )

@@ -234,7 +234,7 @@ def test_model_params_from_the_command_line_are_stored(survey_db):
     d = json.loads(Store(survey_db).query_df("SELECT definition FROM campaigns")["definition"][0])
     assert d["options"]["models"]["MLP"]["hidden_layer_sizes"] == [8, 8]
     assert d["options"]["models"]["MLP"]["max_iter"] == 10
-    assert d["options"]["models"]["MLP"]["early_stopping"] is True  # the baseline's default
+    assert d["options"]["models"]["MLP"]["solver"] == "lbfgs"  # the baseline's default
     assert d["options"]["models"][CUSTOM]["alpha"] == 2
 
 
