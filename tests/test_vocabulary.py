@@ -96,6 +96,21 @@ def test_get_version_finds_by_id_name_and_hash(two_versions, tmp_path):
         get_version(store, "nope")
 
 
+def test_only_preprocess_reads_its_tables():
+    """Every other package goes through `get_version` / `load_samples`, so a change of
+    how a version is stored has one place to change."""
+    import re
+
+    root = Path(__file__).resolve().parents[1] / "suds_exp"
+    table = re.compile(r"\bprep_(?:pca|fits|versions|trials)\b")
+    readers = [
+        str(p.relative_to(root))
+        for p in root.rglob("*.py")
+        if p.parent.name != "preprocess" and table.search(p.read_text())
+    ]
+    assert readers == []
+
+
 def test_replay_uses_the_versions_own_differentiator(two_versions, tmp_path):
     db = tmp_path / "db.duckdb"
     shutil.copyfile(two_versions, db)

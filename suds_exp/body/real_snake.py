@@ -20,7 +20,7 @@ from suds_exp.body.description import load_body
 from suds_exp.body.prep import preprocess_body
 from suds_exp.ingest import ingest_paths
 from suds_exp.models import make_model
-from suds_exp.preprocess import load_samples
+from suds_exp.preprocess import get_version
 from suds_exp.store import Store
 
 #: Learners compared on a chain (the +SUDS ones need passive states a snake has not).
@@ -88,13 +88,9 @@ def run_real_snake(
     # the snake glides at ~7 m/s (~40 mm a frame at 179 Hz): the swimmer's 9 mm jump
     # threshold would call its motion jumps
     result = preprocess_body(store, load_body(body_file), None, {"jump_mm": 30}, progress=False)
-    samples = load_samples(store, result.version_id)
-    loadings = np.asarray(
-        store.query_df(
-            "SELECT loadings FROM prep_pca WHERE version_id = ? ORDER BY component",
-            [result.version_id],
-        ).loadings.tolist()
-    )
+    version = get_version(store, result.version_id)
+    samples = version.samples()
+    loadings = version.pca.components_
     return {
         "version": result.version_id,
         "explained_variance_ratio": result.explained_variance_ratio,
