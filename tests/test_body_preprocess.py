@@ -104,3 +104,18 @@ def test_chain_naming_an_unknown_marker_is_refused(tmp_path):
 def test_missing_body_file_is_one_line(tmp_path):
     out = cli("preprocess", "--body", tmp_path / "nope.toml", "--db", tmp_path / "x.duckdb")
     assert out.exit_code == 2 and "nope.toml: body description not found" in out.stderr
+
+
+def test_chain_refuses_a_reduction_other_than_pca(tmp_path):
+    # a chain's ra_1, ra_2 are its first two PCA modes (the travelling wave Phaser reads):
+    # another reducer would silently not be used, so it is refused by name
+    db = tmp_path / "s.duckdb"
+    assert cli("ingest", _snake_csv(tmp_path / "snake.csv"), "--db", db).exit_code == 0
+    before = dump_db(db)
+    body = _chain_toml(tmp_path / "snake.toml", [f"m{i:02d}" for i in range(1, 11)])
+    out = cli("preprocess", "--body", body, "--param", "reduction=autoencoder", "--db", db)
+    assert out.exit_code == 2
+    message = out.stderr.strip()
+    assert len(message.splitlines()) == 1, message
+    assert "snake.toml: reduction 'autoencoder'" in message and "pca" in message, message
+    assert_same_db(before, dump_db(db))

@@ -66,7 +66,8 @@ def preprocess_body(
     ``params["k"]`` is set from the
     chain's ``modes`` (k = modes - 2). Raises `BodyError` for a description the trials do
     not fit (an unknown marker) or a segment body other than the swimmer (not supported
-    yet), `PreprocessError` as the standard pipeline does.
+    yet) or a ``reduction`` other than PCA for a chain, `PreprocessError` as the standard
+    pipeline does.
     """
     if body.is_swimmer():
         return preprocess(store, name, params, trials, progress, preset=preset)
@@ -104,6 +105,12 @@ def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResul
     given = dict(params or {})
     given["k"] = body.chain.modes - 2
     params = resolve_params(given)
+    if params["reduction"] != "pca":
+        # ra_1, ra_2 are the chain's first two PCA modes, the travelling wave Phaser reads
+        raise BodyError(
+            f"{body.source}: reduction {params['reduction']!r} is for the swimmer's passive "
+            "shape; a chain's shape modes are PCA modes (reduction=pca)"
+        )
     params["body"] = body.to_dict()
     digest = params_hash(params)
     with store.write() as conn:
