@@ -465,7 +465,9 @@ def run(
 
 @command()
 def survey(
-    name: Annotated[str, typer.Argument(help="Campaign with a --sweep (e.g. --models survey).")],
+    name: Annotated[
+        str, typer.Argument(help="Campaign with a --sweep and/or a main grid of cross pairs.")
+    ],
     cycles: Annotated[int, typer.Option(help="Main grid size: GMR's error target.")] = 30,
     versus: Annotated[
         str, typer.Option(help="Learner whose data need is set against GMR's.")
@@ -475,7 +477,8 @@ def survey(
     json_: JsonOption = False,
 ) -> None:
     """Data each learner needs and its speed: cycles to reach x1.25 of its own largest-sweep
-    error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio.
+    error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio (from a
+    sweep); the GLM with the learner as a factor (from a main grid's cross pairs).
 
     Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
     """
@@ -485,11 +488,15 @@ def survey(
     if json_:
         console.print_json(survey_json(tables))
         return
-    console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
+    if "cycles" in tables:
+        console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
     console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
     if "glm" in tables:
         console.print_frame(tables["glm"].round(3), title="GLM, learner as a factor (100 ln)")
-    console.out.print(ratio_sentence(tables["ratio"], cycles))
+    if "ratio" in tables:
+        console.out.print(ratio_sentence(tables["ratio"], cycles))
+    for why in tables.get("missing", []):
+        console.out.print(f"left out: {user_message(why)}")
 
 
 @command()

@@ -9,6 +9,7 @@ from typing import Any
 import pandas as pd
 from rich.console import Console
 from rich.table import Table
+from rich.text import Text
 
 from suds_exp.store.sql import frame_to_json
 
@@ -19,10 +20,11 @@ err = Console(stderr=True, highlight=False, soft_wrap=True)
 def print_frame(frame: pd.DataFrame, title: str | None = None, max_rows: int = 200) -> None:
     """Print a DataFrame as a rich table (first ``max_rows`` rows)."""
     table = Table(title=title, show_lines=False)
+    # cells are data: Text, so a label such as "learner[kNN]" is not read as rich markup
     for column in frame.columns:
-        table.add_column(str(column), overflow="fold")
+        table.add_column(Text(str(column)), overflow="fold")
     for row in frame.head(max_rows).itertuples(index=False):
-        table.add_row(*("" if pd.isna(v) is True else _fmt(v) for v in row))
+        table.add_row(*(Text("" if pd.isna(v) is True else _fmt(v)) for v in row))
     out.print(table)
     if len(frame) > max_rows:
         out.print(f"... {len(frame) - max_rows} more rows")

@@ -264,6 +264,46 @@ def test_survey_command_prints_cycles_to_target_and_the_ratio(survey_db):
     assert doc["ratio"]["model"] == "MLP" and doc["ratio"]["n_boot"] == 50
 
 
+def test_survey_of_a_main_grid_without_sweep_gives_the_glm_and_timing(tmp_path, samples_file):
+    # the paper's grid alone (cross pairs, one size) answers the generalisation question
+    db = tmp_path / "grid.duckdb"
+    opts = CampaignOptions.parse(
+        models="GMR,kNN",
+        boots=2,
+        train_cycles=2,
+        train_conditions="O@0.5,O@1",
+        test_conditions="O@0.5,O@1",
+    )
+    run_campaign(Store(db), "g", opts, samples=pd.read_parquet(samples_file), progress=False)
+    out = CliRunner().invoke(cli.app, ["survey", "g", "--db", str(db), "--cycles", "2", "--json"])
+    assert out.exit_code == 0, out.output
+    doc = json.loads(out.stdout)
+    assert "cycles" not in doc and "ratio" not in doc
+    assert {r["model"] for r in doc["timing"]} == {"GMR", "kNN"}
+    terms = {r["term"] for r in doc["glm"]}
+    assert "learner[kNN]" in terms and any(t.startswith("period_rel") for t in terms)
+    text = CliRunner().invoke(cli.app, ["survey", "g", "--db", str(db), "--cycles", "2"])
+    assert text.exit_code == 0, text.output
+    # labels in brackets are data, not rich markup: none is swallowed
+    assert "learner[kNN]" in text.output and "period_rel[" in text.output
+    assert "left out: survey: no sample-efficiency results" in text.output
+    assert "with --sweep" in text.output
+
+
+def test_survey_of_a_campaign_with_neither_sweep_nor_cross_pairs_is_one_line(
+    tmp_path, samples_file
+):
+    db = tmp_path / "one.duckdb"
+    opts = CampaignOptions.parse(
+        models="GMR", boots=1, train_cycles=2, train_conditions="O@0.5", test_conditions="O@0.5"
+    )
+    run_campaign(Store(db), "one", opts, samples=pd.read_parquet(samples_file), progress=False)
+    out = CliRunner().invoke(cli.app, ["survey", "one", "--db", str(db), "--cycles", "2"])
+    assert out.exit_code == 2
+    assert len(out.output.strip().splitlines()) == 1, out.output
+    assert "sweep" in out.output and "cross pairs" in out.output
+
+
 @pytest.mark.parametrize(
     "args, message",
     [

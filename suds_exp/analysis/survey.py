@@ -46,8 +46,8 @@ def sweep_rows(results: pd.DataFrame) -> pd.DataFrame:
     rows = results[same]
     if rows["n_cycles"].nunique() < 2:
         raise AnalysisError(
-            "survey: the campaign has no sample-efficiency sweep (same-condition results "
-            "at two or more training sizes); run it with sweep, e.g. sweep 1,2,4,8,16,30,48",
+            "survey: no sample-efficiency results (same-condition pairs at two or more "
+            "training sizes); run the campaign with sweep, e.g. 1,2,4,8,16,30,48",
             param="sweep",
         )
     return rows
@@ -309,9 +309,10 @@ SURVEY_COLUMNS = KEY_COLUMNS + (
 def survey_tables(
     store, campaign: str, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
 ) -> dict:
-    """Everything `suds-exp survey` prints: ``cycles`` (`cycles_to_target`), ``timing``
-    (`timing_table`), ``ratio`` (`efficiency_ratio` of ``model`` against GMR) and, when
-    the campaign has cross pairs, ``glm`` (`learner_glm`)."""
+    """Everything `suds-exp survey` prints: ``timing`` (`timing_table`); with a sweep,
+    ``cycles`` (`cycles_to_target`) and ``ratio`` (`efficiency_ratio` of ``model`` against
+    GMR); with cross pairs, ``glm`` (`learner_glm`); ``missing``: why a part is left out
+    (see `survey_from_results`)."""
     from suds_exp.analysis.queries import load_results
 
     results = load_results(store, campaign, columns=SURVEY_COLUMNS)
@@ -321,17 +322,30 @@ def survey_tables(
 def survey_from_results(
     results: pd.DataFrame, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
 ) -> dict:
-    """`survey_tables` of results already loaded (e.g. several campaigns pooled); ``glm``
-    (`learner_glm`) only when the results hold cross pairs at ``main_cycles``."""
-    out = {
-        "cycles": cycles_to_target(results, main_cycles),
-        "timing": timing_table(results),
-        "ratio": efficiency_ratio(results, model, main_cycles=main_cycles, n_boot=n_boot),
-    }
+    """`survey_tables` of results already loaded (e.g. several campaigns pooled).
+
+    ``cycles`` and ``ratio`` need a sweep, ``glm`` (`learner_glm`) cross pairs at
+    ``main_cycles``; a campaign with one of the two gets what it supports and, under
+    ``missing``, the `AnalysisError` that left the rest out. With neither, one
+    `AnalysisError` says both.
+    """
+    out: dict = {"timing": timing_table(results)}
+    missing = []
+    try:
+        sweep_rows(results)
+    except AnalysisError as no_sweep:
+        missing.append(no_sweep)
+    else:
+        out["cycles"] = cycles_to_target(results, main_cycles)
+        out["ratio"] = efficiency_ratio(results, model, main_cycles=main_cycles, n_boot=n_boot)
     try:
         out["glm"] = learner_glm(results, main_cycles)
-    except AnalysisError:
-        pass  # a sweep without cross pairs: nothing to say about generalisation
+    except AnalysisError as no_grid:
+        missing.append(no_grid)
+    if "cycles" not in out and "glm" not in out:
+        raise AnalysisError("; ".join(map(str, missing)), param="sweep")
+    if missing:
+        out["missing"] = missing
     return out
 
 
@@ -347,6 +361,8 @@ def survey_json(tables: dict) -> dict:
     for key, value in tables.items():
         if isinstance(value, pd.DataFrame):
             out[key] = [{k: clean(v) for k, v in r.items()} for r in value.to_dict("records")]
+        elif isinstance(value, list):
+            out[key] = [str(v) for v in value]
         else:
             out[key] = {k: clean(v) for k, v in value.items()}
     return out
