@@ -55,15 +55,15 @@ STEP_HINGE = 1.0
 
 
 @njit(cache=True)
-def _element_geometry(
-    phi1, phi2, dphi1, dphi2, ang, el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side, geo
-):
+def _element_geometry(phi1, phi2, dphi1, dphi2, ang, body, geo):
     """Positions, axes, hinge columns and shape-driven velocities of all elements.
 
-    geo: array (n_el, 9) filled with px, py, tx, ty, bx, by, cx, cy, hinge index
-    (body frame, units of L_ref; b = velocity per unit hinge rate, c = velocity from
-    the shape rate).
+    body: the elements' description (el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy,
+    fl_side; see `run_trials`). geo: array (n_el, 9) filled with px, py, tx, ty, bx, by,
+    cx, cy, hinge index (body frame, units of L_ref; b = velocity per unit hinge rate,
+    c = velocity from the shape rate).
     """
+    el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side = body
     c1, s1 = math.cos(phi1), math.sin(phi1)
     c2, s2 = math.cos(-phi2), math.sin(-phi2)
     for e in range(el_part.shape[0]):
@@ -681,6 +681,113 @@ def _flipper_midpoints(ang, uprev, held, h, amax, mode, amid):
 
 
 @njit(cache=True)
+def _bed_half_var(bed_k):
+    """Half the variance of the bed field's log (bed.py) from its modes ``bed_k``."""
+    half_var = 0.0
+    for m in range(bed_k.shape[0]):
+        half_var += 0.25 * bed_k[m, 3] * bed_k[m, 3]
+    return half_var
+
+
+@njit(cache=True)
+def _joint_substep(phi_k, f, fa, fb, servo, r1, r2, load1, load2, h, p):
+    """The joint angles (rad) at the start (a1, a2) and end (b1, b2) of the substep from
+    fraction ``fa`` to ``fb`` of frame interval f: the given path, or with a servo the
+    joints' own motion towards the command under load; returns them and the servo state
+    (r1, r2: the joints where the substep ends)."""
+    a1 = phi_k[f, 0] + fa * (phi_k[f + 1, 0] - phi_k[f, 0])
+    a2 = phi_k[f, 1] + fa * (phi_k[f + 1, 1] - phi_k[f, 1])
+    b1 = phi_k[f, 0] + fb * (phi_k[f + 1, 0] - phi_k[f, 0])
+    b2 = phi_k[f, 1] + fb * (phi_k[f + 1, 1] - phi_k[f, 1])
+    if servo:
+        # b = command at the step's end; the joints move from where they are
+        a1, a2 = r1, r2
+        b1 = r1 + h * _servo_rate(b1 - r1, load1, h, p)
+        b2 = r2 + h * _servo_rate(b2 - r2, load2, h, p)
+        r1, r2 = b1, b2
+    return a1, a2, b1, b2, r1, r2
+
+
+@njit(cache=True)
+def _predict_twist(x, xlast):
+    """Linear predictor of the body twist x[0:3] from the last two solves (xlast: the
+    one before), the Newton solve's start."""
+    for i in range(3):
+        xo = x[i]
+        x[i] = 2.0 * x[i] - xlast[i]
+        xlast[i] = xo
+
+
+@njit(cache=True)
+def _relax_and_move(x, s, lref, relax, h, v0, v1, v2, X, Y, TH, dist):
+    """The twist (v0, v1 mm/s, v2 rad/s) relaxed towards the solve's x (scaled by the
+    shape rate s) with factor ``relax`` (1: quasi-static), and the pose (X, Y mm, TH rad)
+    and distance travelled (in L_ref) moved by it over h s."""
+    qs0 = x[0] * s * lref
+    qs1 = x[1] * s * lref
+    qs2 = x[2] * s
+    v0 += relax * (qs0 - v0)
+    v1 += relax * (qs1 - v1)
+    v2 += relax * (qs2 - v2)
+    X, Y, TH, moved = _se2_step(X, Y, TH, v0 * h, v1 * h, v2 * h)
+    return v0, v1, v2, X, Y, TH, dist + moved / lref
+
+
+@njit(cache=True)
+def _record_frame(k, i, X, Y, TH, ang, rmax, j1, j2, pose, ang_out, resid, phi_out):
+    """Write frame i of trial k: pose, flipper angles, residual and joint angles."""
+    pose[k, i, 0] = X
+    pose[k, i, 1] = Y
+    pose[k, i, 2] = TH
+    for j in range(4):
+        ang_out[k, i, j] = ang[j]
+    resid[k, i] = rmax
+    phi_out[k, i, 0] = j1
+    phi_out[k, i, 1] = j2
+
+
+@njit(cache=True)
+def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k):
+    """One substep of trial interval f, from fraction ``fa`` to ``fb`` of it: the joints
+    move (`_joint_substep`), the balance of forces is solved at the midpoint, the twist
+    relaxes and the pose moves, free flippers advance.
+
+    state: (r1, r2, load1, load2, v0, v1, v2, X, Y, TH, dist), the servo joints (rad),
+    their loads (scaled), the twist (mm/s, rad/s), the pose (mm, rad) and the distance
+    travelled (L_ref); trial: (h s, load low-pass factor, relax factor, half the bed's
+    log variance, packing scale); buf: the work arrays of `run_trials`. Returns the new
+    state and the solve's (scaled residual, iterations, whether continuation was used).
+    """
+    r1, r2, load1, load2, v0, v1, v2, X, Y, TH, dist = state
+    h, lp, relax, half_var, bed_scale = trial
+    geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed = buf
+    lref, amax, mode = p[P_LREF], p[P_AMAX], int(p[P_FLMODE])
+    servo = p[P_SGAIN] > 0.0
+    a1, a2, b1, b2, r1, r2 = _joint_substep(phi_k, f, fa, fb, servo, r1, r2, load1, load2, h, p)
+    d1 = (b1 - a1) / h
+    d2 = (b2 - a2) / h
+    s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
+    _flipper_midpoints(ang, uprev, held, h, amax, mode, amid)
+    _element_geometry(0.5 * (a1 + b1), 0.5 * (a2 + b2), d1 / s, d2 / s, amid, body, geo)
+    has_bed = half_var > 0.0 or bed_scale != 1.0
+    _bed_weights(w_eff, geo, bed_k, bed_scale, half_var, has_bed, X, Y, TH, lref, w_bed)
+    _predict_twist(x, xlast)
+    normal_fac = p[P_NORMAL] * (1.0 + p[P_COMPACT] * dist)
+    nr, it, cont = _solve_with_stops(
+        x, geo, w_bed, body[0], p, normal_fac, held, amid, p[P_CHINGE] * s, work
+    )
+    # the servos feel the medium's torque of this step at the next ones, low-passed: an
+    # unfiltered one-step-late load makes the joint chatter (its size depends on the
+    # rates it sets)
+    load1 += lp * (abs(work[4, 4]) - load1)
+    load2 += lp * (abs(work[4, 5]) - load2)
+    v0, v1, v2, X, Y, TH, dist = _relax_and_move(x, s, lref, relax, h, v0, v1, v2, X, Y, TH, dist)
+    if mode == FL_FREE:
+        _advance_flippers(x, s, h, amax, held, ang, uprev)
+    return (r1, r2, load1, load2, v0, v1, v2, X, Y, TH, dist), nr, it, cont
+
+
+@njit(cache=True)
 def run_trials(
     phi,
     n_steps,
@@ -719,137 +826,55 @@ def run_trials(
     frames; ang_out (n_trials, n_frames, 4); resid (n_trials, n_frames) max scaled
     residual of the solves ending at each frame; iters, n_cont (n_trials,) totals.
     """
-    n_trials = phi.shape[0]
     n_el = el_part.shape[0]
-    geo = np.empty((n_el, 9))
-    work = np.zeros((6, N_UNKNOWN))
-    x = np.zeros(N_UNKNOWN)
-    xlast = np.zeros(N_UNKNOWN)
-    held = np.zeros(4, dtype=np.bool_)
-    ang = np.zeros(4)
-    amid = np.zeros(4)
-    uprev = np.zeros(4)
-    w_eff = np.empty(n_el)
-    w_bed = np.empty(n_el)
-    for k in range(n_trials):
+    body = (el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side)
+    geo, work = np.empty((n_el, 9)), np.zeros((6, N_UNKNOWN))
+    x, xlast = np.zeros(N_UNKNOWN), np.zeros(N_UNKNOWN)
+    held, ang, amid, uprev = np.zeros(4, dtype=np.bool_), np.zeros(4), np.zeros(4), np.zeros(4)
+    w_eff, w_bed = np.empty(n_el), np.empty(n_el)
+    buf = (geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed)
+    for k in range(phi.shape[0]):
         p = prm[k]
-        lref = p[P_LREF]
-        amax = p[P_AMAX]
-        mode = int(p[P_FLMODE])
         nsub = int(p[P_SUBSTEPS])
-        tau = p[P_TAU]
         h = dt / nsub
-        relax = 1.0 if tau <= 0.0 else 1.0 - math.exp(-h / tau)
-        lp = 1.0 - math.exp(-h / SERVO_LOAD_TAU)
+        relax = 1.0 if p[P_TAU] <= 0.0 else 1.0 - math.exp(-h / p[P_TAU])
+        trial = (h, 1.0 - math.exp(-h / SERVO_LOAD_TAU), relax, _bed_half_var(bed[k]), bed_scale[k])
         _start_trial(p, el_w, el_part, ang0[k], w_eff, ang, held, uprev, x, xlast)
-        X, Y, TH = pose0[k, 0], pose0[k, 1], pose0[k, 2]
         servo = p[P_SGAIN] > 0.0
         r1, r2 = phi[k, 0, 0], phi[k, 0, 1]
-        load1, load2 = 0.0, 0.0
-        phi_out[k, 0, 0] = r1
-        phi_out[k, 0, 1] = r2
-        half_var = 0.0  # the variance of the field's log / 2 (bed.py)
-        for m in range(bed.shape[1]):
-            half_var += 0.25 * bed[k, m, 3] * bed[k, m, 3]
-        has_bed = half_var > 0.0 or bed_scale[k] != 1.0
-        v_prev0, v_prev1, v_prev2 = 0.0, 0.0, 0.0
-        dist = 0.0
+        X, Y, TH = pose0[k, 0], pose0[k, 1], pose0[k, 2]
+        state = (r1, r2, 0.0, 0.0, 0.0, 0.0, 0.0, X, Y, TH, 0.0)
         iters[k] = 0
         n_cont[k] = 0
         nf = n_steps[k]
-        pose[k, 0, 0] = X
-        pose[k, 0, 1] = Y
-        pose[k, 0, 2] = TH
-        for i in range(4):
-            ang_out[k, 0, i] = ang[i]
-        resid[k, 0] = 0.0
+        _record_frame(k, 0, X, Y, TH, ang, 0.0, r1, r2, pose, ang_out, resid, phi_out)
         last0, last1, last2 = 0.0, 0.0, 0.0
         for f in range(nf - 1):
             sum0, sum1, sum2 = 0.0, 0.0, 0.0
             rmax = 0.0
             for sub in range(nsub):
-                fa = sub / nsub
-                fb = (sub + 1) / nsub
-                a1 = phi[k, f, 0] + fa * (phi[k, f + 1, 0] - phi[k, f, 0])
-                a2 = phi[k, f, 1] + fa * (phi[k, f + 1, 1] - phi[k, f, 1])
-                b1 = phi[k, f, 0] + fb * (phi[k, f + 1, 0] - phi[k, f, 0])
-                b2 = phi[k, f, 1] + fb * (phi[k, f + 1, 1] - phi[k, f, 1])
-                if servo:
-                    # b = command at the step's end; the joints move from where they are
-                    a1, a2 = r1, r2
-                    b1 = r1 + h * _servo_rate(b1 - r1, load1, h, p)
-                    b2 = r2 + h * _servo_rate(b2 - r2, load2, h, p)
-                    r1, r2 = b1, b2
-                d1 = (b1 - a1) / h
-                d2 = (b2 - a2) / h
-                s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
-                _flipper_midpoints(ang, uprev, held, h, amax, mode, amid)
-                _element_geometry(
-                    0.5 * (a1 + b1),
-                    0.5 * (a2 + b2),
-                    d1 / s,
-                    d2 / s,
-                    amid,
-                    el_part,
-                    el_s,
-                    half_mid,
-                    fl_seg,
-                    fl_hx,
-                    fl_hy,
-                    fl_side,
-                    geo,
+                state, nr, it, cont = _substep(
+                    phi[k], f, sub / nsub, (sub + 1) / nsub, p, state, trial, body, buf, bed[k]
                 )
-                _bed_weights(
-                    w_eff, geo, bed[k], bed_scale[k], half_var, has_bed, X, Y, TH, lref, w_bed
-                )
-                # linear predictor of the body twist from the last two solves
-                for i in range(3):
-                    xo = x[i]
-                    x[i] = 2.0 * x[i] - xlast[i]
-                    xlast[i] = xo
-                normal_fac = p[P_NORMAL] * (1.0 + p[P_COMPACT] * dist)
-                c_hinge = p[P_CHINGE] * s
-                nr, it, cont = _solve_with_stops(
-                    x, geo, w_bed, el_part, p, normal_fac, held, amid, c_hinge, work
-                )
-                # the servos feel the medium's torque of this step at the next ones,
-                # low-passed: an unfiltered one-step-late load makes the joint chatter
-                # (the load's size depends on the rates it sets)
-                load1 += lp * (abs(work[4, 4]) - load1)
-                load2 += lp * (abs(work[4, 5]) - load2)
                 iters[k] += it
                 if cont:
                     n_cont[k] += 1
                 if nr > rmax:
                     rmax = nr
-                qs0 = x[0] * s * lref
-                qs1 = x[1] * s * lref
-                qs2 = x[2] * s
-                v_prev0 += relax * (qs0 - v_prev0)
-                v_prev1 += relax * (qs1 - v_prev1)
-                v_prev2 += relax * (qs2 - v_prev2)
-                X, Y, TH, moved = _se2_step(X, Y, TH, v_prev0 * h, v_prev1 * h, v_prev2 * h)
-                dist += moved / lref
-                if mode == FL_FREE:
-                    _advance_flippers(x, s, h, amax, held, ang, uprev)
-                sum0 += v_prev0
-                sum1 += v_prev1
-                sum2 += v_prev2
+                sum0 += state[4]
+                sum1 += state[5]
+                sum2 += state[6]
             m0, m1, m2 = sum0 / nsub, sum1 / nsub, sum2 / nsub
             # the twist centred on frame f: mean of the frame intervals either side
-            w = 1.0 if f == 0 else 0.5
-            vel[k, f, 0] = m0 if f == 0 else w * (last0 + m0)
-            vel[k, f, 1] = m1 if f == 0 else w * (last1 + m1)
-            vel[k, f, 2] = m2 if f == 0 else w * (last2 + m2)
+            vel[k, f, 0] = m0 if f == 0 else 0.5 * (last0 + m0)
+            vel[k, f, 1] = m1 if f == 0 else 0.5 * (last1 + m1)
+            vel[k, f, 2] = m2 if f == 0 else 0.5 * (last2 + m2)
             last0, last1, last2 = m0, m1, m2
-            phi_out[k, f + 1, 0] = r1 if servo else phi[k, f + 1, 0]
-            phi_out[k, f + 1, 1] = r2 if servo else phi[k, f + 1, 1]
-            pose[k, f + 1, 0] = X
-            pose[k, f + 1, 1] = Y
-            pose[k, f + 1, 2] = TH
-            for i in range(4):
-                ang_out[k, f + 1, i] = ang[i]
-            resid[k, f + 1] = rmax
+            j1 = state[0] if servo else phi[k, f + 1, 0]
+            j2 = state[1] if servo else phi[k, f + 1, 1]
+            X, Y, TH = state[7], state[8], state[9]
+            _record_frame(k, f + 1, X, Y, TH, ang, rmax, j1, j2, pose, ang_out, resid, phi_out)
+        # the last frame keeps the last interval's twist (none for a one-frame trial)
         if nf >= 2:
             vel[k, nf - 1, 0] = last0
             vel[k, nf - 1, 1] = last1
@@ -884,24 +909,11 @@ def solve_twists(
             w_eff[e] = 0.0
     for i in range(4):
         ang[i] = prm[P_FLLOCK]
+    body = (el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side)
     for n in range(phis.shape[0]):
         d1, d2 = dphis[n, 0], dphis[n, 1]
         s = math.sqrt(d1 * d1 + d2 * d2 + prm[P_SFLOOR] * prm[P_SFLOOR])
-        _element_geometry(
-            phis[n, 0],
-            phis[n, 1],
-            d1 / s,
-            d2 / s,
-            ang,
-            el_part,
-            el_s,
-            half_mid,
-            fl_seg,
-            fl_hx,
-            fl_hy,
-            fl_side,
-            geo,
-        )
+        _element_geometry(phis[n, 0], phis[n, 1], d1 / s, d2 / s, ang, body, geo)
         for i in range(N_UNKNOWN):
             x[i] = 0.0
         nr, _, _ = _solve_step(x, geo, w_eff, el_part, prm, prm[P_NORMAL], held, ang, 0.0, work)
