@@ -673,8 +673,9 @@ def demo(
     """
     from suds_exp.testing.demo import run_demo
 
-    say = (lambda line: None) if json_ else console.out.print
-    summary = run_demo(open_store(db), out, jobs=jobs, progress=not (quiet or json_), say=say)
+    summary = run_demo(
+        open_store(db), out, jobs=jobs, progress=not (quiet or json_), narrate=not json_
+    )
     if json_:
         console.print_json(summary.__dict__)
     else:

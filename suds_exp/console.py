@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable
 from typing import Any
 
 import pandas as pd
@@ -34,6 +35,15 @@ def _fmt(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
     return str(value)
+
+
+def output_lines(enabled: bool = True) -> Callable[[str], None]:
+    """``say(line)`` for a function whose output is a narration (the demo): each line on
+    stdout as plain text when enabled, else nothing (``--json`` prints one document
+    instead). Progress goes to stderr (`suds_exp.progress`); this is the result."""
+    if not enabled:
+        return lambda _line: None
+    return lambda line: out.print(line, markup=False, highlight=False)
 
 
 def print_json(document: Any) -> None:

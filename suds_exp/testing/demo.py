@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from suds_exp.console import output_lines
 from suds_exp.errors import IngestError
 from suds_exp.store import Store
 
@@ -49,18 +49,20 @@ def run_demo(
     seed: int = 0,
     hidden_effect: str = "body_inertia",
     progress: bool = True,
-    say: Callable[[str], None] = print,
+    narrate: bool = True,
 ) -> DemoSummary:
     """Run the demo end to end into ``store``; returns a `DemoSummary`.
 
     ``report_dir / campaign`` receives the campaign report and
     ``report_dir / "discrepancy-demo"`` the discrepancy report of ``hidden_effect``
-    hidden in new simulated data. ``say`` gets one line per finished step (the demo's
-    narration, its output rather than its progress).
+    hidden in new simulated data. ``progress``: bars and stage lines on stderr;
+    ``narrate``: one line per finished step on stdout (the demo's output, as
+    `suds_exp.console.output_lines`).
     """
     from suds_exp.analysis import write_report
     from suds_exp.testing.demo_campaign import demo_campaign
 
+    say = output_lines(narrate)
     summary = DemoSummary(campaign=campaign)
     lap = _Clock(summary).lap
     simulate_and_ingest(store, summary, seed, progress, say, lap)
