@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import duckdb
@@ -94,3 +95,32 @@ def assert_same_db(before: dict[str, pd.DataFrame], after: dict[str, pd.DataFram
     assert sorted(before) == sorted(after)
     for name in before:
         pd.testing.assert_frame_equal(before[name], after[name], check_dtype=False)
+
+
+# A sweep small enough for the default suite: 2 gaits x 2 frequencies x 3 repeats.
+SMALL_SWEEP = dict(gaits=("S+", "D+"), frequencies_hz=(0.5, 1.0), repeats=3, cycles=(3, 4))
+
+
+def inertia_store(work: Path, tau_s: float, seed: int) -> Path:
+    """Database of `SMALL_SWEEP` simulated with body inertia ``tau_s`` (s), an effect the
+    nominal model lacks; returns its path."""
+    from suds_exp.sim.config import SimConfig
+    from suds_exp.testing.hidden_effects import simulate_measured
+
+    truth = SimConfig()
+    truth.effects.body_inertia.tau_s = tau_s
+    simulate_measured(work, truth, seed=seed, **SMALL_SWEEP)
+    return work / "suds.duckdb"
+
+
+def discrepancy_json(db: Path, out: Path, *args: str) -> tuple[dict, Path]:
+    """``suds-exp discrepancy --db db --out out *args --json`` through the CLI: the
+    printed document and the report folder; fails the test on a non-zero exit."""
+    from typer.testing import CliRunner
+
+    from cli import app
+
+    argv = ["discrepancy", "--db", str(db), "--out", str(out), *args, "--json"]
+    res = CliRunner().invoke(app, argv)
+    assert res.exit_code == 0, res.output
+    return json.loads(res.stdout), out

@@ -18,43 +18,24 @@ from typer.testing import CliRunner
 
 from cli import app
 from suds_exp.discrepancy.effects import effect_names
-from suds_exp.sim.config import SimConfig
 from suds_exp.store import Store
-from suds_exp.testing.hidden_effects import simulate_measured
+from tests.conftest import discrepancy_json, inertia_store
 
 runner = CliRunner()
-SMALL = dict(gaits=("S+", "D+"), frequencies_hz=(0.5, 1.0), repeats=3, cycles=(3, 4))
 
 
 @pytest.fixture(scope="module")
 def inertia_db(tmp_path_factory) -> Path:
-    work = tmp_path_factory.mktemp("withheld")
-    truth = SimConfig()
-    truth.effects.body_inertia.tau_s = 0.3
-    simulate_measured(work, truth, seed=5, **SMALL)
-    return work / "suds.duckdb"
+    return inertia_store(tmp_path_factory.mktemp("withheld"), tau_s=0.3, seed=5)
 
 
 @pytest.fixture(scope="module")
 def unexplained_run(inertia_db, tmp_path_factory):
     out = tmp_path_factory.mktemp("report") / "disc"
-    res = runner.invoke(
-        app,
-        [
-            "discrepancy",
-            "--db",
-            str(inertia_db),
-            "--out",
-            str(out),
-            "--exclude-candidates",
-            ",".join(effect_names()),
-            "--name",
-            "withheld-all",
-            "--json",
-        ],
+    excluded = ",".join(effect_names())
+    return discrepancy_json(
+        inertia_db, out, "--exclude-candidates", excluded, "--name", "withheld-all"
     )
-    assert res.exit_code == 0, res.output
-    return json.loads(res.stdout), out
 
 
 def test_unexplained_gap_is_discovered_as_an_inertia(unexplained_run):

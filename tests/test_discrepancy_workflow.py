@@ -24,44 +24,23 @@ from suds_exp.testing.hidden_effects import (
     demo_discrepancy,
     draw_hidden,
     hidden_effect_run,
-    simulate_measured,
 )
+from tests.conftest import SMALL_SWEEP, discrepancy_json, inertia_store
 
 runner = CliRunner()
 TAU = 0.2
-SMALL = dict(gaits=("S+", "D+"), frequencies_hz=(0.5, 1.0), repeats=3, cycles=(3, 4))
 
 
 @pytest.fixture(scope="module")
 def inertia_db(tmp_path_factory) -> Path:
     """A store holding a small dataset simulated with body inertia the nominal model lacks."""
-    work = tmp_path_factory.mktemp("hidden")
-    truth = SimConfig()
-    truth.effects.body_inertia.tau_s = TAU
-    simulate_measured(work, truth, seed=3, **SMALL)
-    return work / "suds.duckdb"
+    return inertia_store(tmp_path_factory.mktemp("hidden"), tau_s=TAU, seed=3)
 
 
 @pytest.fixture(scope="module")
 def cli_run(inertia_db, tmp_path_factory):
     out = tmp_path_factory.mktemp("report") / "disc"
-    res = runner.invoke(
-        app,
-        [
-            "discrepancy",
-            "--db",
-            str(inertia_db),
-            "--out",
-            str(out),
-            "--max-effects",
-            "2",
-            "--name",
-            "hidden-inertia",
-            "--json",
-        ],
-    )
-    assert res.exit_code == 0, res.output
-    return json.loads(res.stdout), out
+    return discrepancy_json(inertia_db, out, "--max-effects", "2", "--name", "hidden-inertia")
 
 
 def test_names_the_hidden_effect_with_an_interval_covering_the_truth(cli_run):
@@ -123,7 +102,7 @@ def test_report_page_is_self_contained(cli_run):
 
 
 def test_demo_reports_the_hidden_effect_and_the_gap(tmp_path):
-    summary = demo_discrepancy("drag_anisotropy", seed=4, out=tmp_path / "rep", **SMALL)
+    summary = demo_discrepancy("drag_anisotropy", seed=4, out=tmp_path / "rep", **SMALL_SWEEP)
     (hidden,) = summary["hidden"]
     assert hidden == "drag_anisotropy"
     assert summary["named"][0]["effect"] == "drag_anisotropy"

@@ -52,21 +52,17 @@ def category_boxplots(
     width = max(4.0, 0.6 * len(models) + 1.5)
     paths = {}
 
-    fig = Figure(figsize=(2 * width, 4.5), layout="constrained")
-    axes = fig.subplots(1, len(FREQ_SIM), sharey=True)
-    for ax, cat in zip(axes, FREQ_SIM, strict=True):
-        _panel(ax, rows[rows["freq_sim"] == cat], models, _FREQ_TITLE[cat])
-    axes[0].set_ylabel(YLABEL)
-    fig.suptitle(f"Prediction error by frequency similarity ({size} training cycles)")
-    paths["boxplot_frequency"] = _save(fig, out_dir / "boxplot_frequency.png")
-
-    fig = Figure(figsize=(3 * width, 4.5), layout="constrained")
-    axes = fig.subplots(1, len(GAIT_SIM), sharey=True)
-    for ax, cat in zip(axes, GAIT_SIM, strict=True):
-        _panel(ax, rows[rows["gait_sim"] == cat], models, _GAIT_TITLE[cat])
-    axes[0].set_ylabel(YLABEL)
-    fig.suptitle(f"Prediction error by gait similarity ({size} training cycles)")
-    paths["boxplot_gait"] = _save(fig, out_dir / "boxplot_gait.png")
+    for column, cats, titles, what in (
+        ("freq_sim", FREQ_SIM, _FREQ_TITLE, "frequency"),
+        ("gait_sim", GAIT_SIM, _GAIT_TITLE, "gait"),
+    ):
+        fig = Figure(figsize=(len(cats) * width, 4.5), layout="constrained")
+        axes = fig.subplots(1, len(cats), sharey=True)
+        for ax, cat in zip(axes, cats, strict=True):
+            _panel(ax, rows[rows[column] == cat], models, titles[cat])
+        axes[0].set_ylabel(YLABEL)
+        fig.suptitle(f"Prediction error by {what} similarity ({size} training cycles)")
+        paths[f"boxplot_{what}"] = _save(fig, out_dir / f"boxplot_{what}.png")
 
     fig = Figure(figsize=(3 * width, 8.5), layout="constrained")
     axes = fig.subplots(len(FREQ_SIM), len(GAIT_SIM), sharey=True)
