@@ -15,6 +15,15 @@ interval covers the true value and the held-out gap at least halves.
 rate at which the gap is reported as unexplained by the library, the held-out gap closed
 by the discovered correction, and its leading features.
 
+`--detection EFFECT --values V1,V2,... --detection-seeds S1,S2,...`: the detection limit
+of one effect on the slow tests' design: the effect hidden at each fixed value of its
+parameter (no draw), run at each seed; per value it prints how often the effect is named
+first, the candidate's held-out p (raw and Bonferroni-adjusted), the held-out loss it
+removes, its fitted value and the gap. For example the spoke oscillation's edge:
+
+    .venv/bin/python benchmarks/discrepancy.py --detection spoke_oscillation \
+        --values 1.3,1.4,1.5 --detection-seeds 11,14,15 --out bench-detect.csv
+
 `--form-mismatch`: the same on the effects whose nearest candidate has the same mechanism
 but another form (`FORM_MISMATCH`: dry hinge friction, approximated by viscous hinge
 damping; a drag that grows with distance, approximated by a constant drag scale): the
@@ -200,13 +209,62 @@ def default_timing(seed: int = 0, withheld: bool = False) -> dict:
     }
 
 
+def detection_run(effect: str, value: float, seed: int) -> dict:
+    """One run with ``effect`` hidden at ``value`` of its parameter: the first step's
+    verdict on that effect's candidate."""
+    fixed, param = HIDDEN[effect]
+    run = hidden_effect_run({effect: {**fixed, param: value}}, seed=seed, **DESIGN)
+    res = run.result
+    cand = next(
+        c
+        for c in res.steps[0].candidates
+        if c.candidate.effect == effect and c.candidate.param == param
+    )
+    ci = cand.ci or (np.nan, np.nan)
+    return {
+        "effect": effect,
+        "value": value,
+        "seed": seed,
+        "named_first": bool(res.named and res.named[0]["effect"] == effect),
+        "p": cand.p_value,
+        "p_adjusted": cand.p_adjusted,
+        "removed": cand.improvement,
+        "fitted": cand.value,
+        "ci_lo": ci[0],
+        "ci_hi": ci[1],
+        "gap": res.gap_before,
+    }
+
+
+def detection(effect: str, values: list[float], seeds: list[int], out: Path) -> None:
+    """Run `detection_run` over values x seeds (rows already in ``out`` are kept and
+    skipped) and print the per-value summary."""
+    plan = [(value, seed) for value in values for seed in seeds]
+    table = run_plan(plan, out, "value", lambda value, seed: detection_run(effect, value, seed))
+    table = table[table["effect"] == effect]
+    summary = table.groupby("value").agg(
+        seeds=("seed", "size"),
+        named_first=("named_first", "mean"),
+        p_min=("p", "min"),
+        p_max=("p", "max"),
+        p_adjusted_min=("p_adjusted", "min"),
+        p_adjusted_max=("p_adjusted", "max"),
+        removed_median=("removed", "median"),
+        fitted_median=("fitted", "median"),
+        gap_median=("gap", "median"),
+    )
+    print(f"\ndetection of {effect} ({HIDDEN[effect][1]}) on the slow tests' design")
+    print(summary.to_string())
+
+
 def run_plan(plan, out: Path, key: str, run) -> pd.DataFrame:
-    """Run ``run(effect, seed)`` for each planned pair not yet in ``out`` (column ``key``
-    holds the effect, "none" for None), appending each row as it finishes."""
+    """Run ``run(item, seed)`` for each planned pair not yet in ``out`` (column ``key``
+    holds the item: the effect, "none" for None, or a parameter value), appending each
+    row as it finishes."""
     done = pd.read_csv(out) if out.exists() else pd.DataFrame()
     have = set(zip(done.get(key, []), done.get("seed", []), strict=False))
     for effect, seed in plan:
-        if ((effect or "none"), seed) in have:
+        if ("none" if effect is None else effect, seed) in have:
             continue
         row = run(effect, seed)
         print(row, flush=True)
@@ -243,7 +301,19 @@ def main() -> None:
         action="store_true",
         help="--withheld on the effects of FORM_MISMATCH (a near candidate of another form)",
     )
+    ap.add_argument("--detection", metavar="EFFECT", help="detection limit of this effect")
+    ap.add_argument("--values", help="with --detection: parameter values, comma-separated")
+    ap.add_argument("--detection-seeds", default="11,12,13", help="with --detection")
     args = ap.parse_args()
+    if args.detection:
+        if args.detection not in HIDDEN:
+            ap.error(f"--detection {args.detection}: expected one of {', '.join(sorted(HIDDEN))}")
+        if not args.values:
+            ap.error("--detection needs --values, e.g. --values 1.3,1.4,1.5")
+        values = [float(v) for v in (args.values or "").split(",") if v]
+        seeds = [int(v) for v in args.detection_seeds.split(",") if v]
+        detection(args.detection, values, seeds, args.out)
+        return
     if args.form_mismatch:
         args.withheld, args.effects = True, ",".join(FORM_MISMATCH)
     seeds = range(args.first_seed, args.first_seed + args.seeds)
