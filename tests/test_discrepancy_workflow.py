@@ -11,6 +11,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
@@ -164,6 +165,37 @@ def test_hidden_runs_start_from_a_model_without_the_hidden_effect():
     assert "spoke_oscillation" in {c.label for c in candidates_for(start)}
     _, start = hidden_models({})
     assert start.effects.spoke_oscillation.gain == SimConfig().effects.spoke_oscillation.gain
+
+
+def _residual_windows(rng, passive_signal: float):
+    """36 windows of 3 gait cycles, as the slow tests' design (3 gaits x 3 frequencies x
+    4 trials) with vx, vy, wz and 4 passive-shape channels: noise everywhere, plus a
+    phase-locked error of ``passive_signal`` in the last channel only."""
+    phase = np.linspace(0, 6 * np.pi, 200)
+    conditions = [(g, f) for g in ("S+", "O", "D+") for f in (1 / 3, 0.5, 1.0)]
+    info = pd.DataFrame(
+        [
+            dict(trial_id=4 * c + k, gait=g, frequency_hz=f)
+            for c, (g, f) in enumerate(conditions)
+            for k in range(4)
+        ]
+    )
+    residual = rng.normal(size=(len(info), len(phase), 7))
+    residual[..., 6] += passive_signal * np.sin(phase)
+    halves = (info["trial_id"].to_numpy()[::2], info["trial_id"].to_numpy()[1::2])
+    return residual, np.tile(phase, (len(info), 1)), info, halves
+
+
+def test_a_gap_in_the_passive_shape_alone_is_systematic():
+    """The gap is measured on every compared channel, r_p included, so its systematic
+    test must look at all of them: a model without the spokes' ringing errs in r_p only."""
+    from suds_exp.discrepancy.localise import systematic_gap
+
+    rng = np.random.default_rng(0)
+    _, p = systematic_gap(*_residual_windows(rng, passive_signal=3.0))
+    assert p < 0.01
+    _, p_noise = systematic_gap(*_residual_windows(rng, passive_signal=0.0))
+    assert p_noise > 0.01
 
 
 def test_replay_steps_resolve_the_spoke_ringing_at_slow_gaits():

@@ -132,15 +132,18 @@ def systematic_gap(
 ) -> tuple[float, float]:
     """Is the remaining residual systematic? Split-half agreement of its phase profile.
 
-    For every condition and channel, the mean residual per phase bin is computed on the
-    windows of each half of the trials (``halves``: two arrays of trial ids); a model
-    error repeats in both halves (positive correlation), noise does not. Returns the mean
-    Fisher-z of those correlations and the one-sided p-value of a t-test over
-    (condition, channel) pairs that it is > 0.
+    ``residual`` (n_windows, n_samples, n_channels): every compared channel, the passive
+    shape's included, since the gap it tests is measured on all of them (a model without
+    the spokes' ringing leaves its error in r_p only). For every condition and channel,
+    the mean residual per phase bin is computed on the windows of each half of the trials
+    (``halves``: two arrays of trial ids); a model error repeats in both halves (positive
+    correlation), noise does not. Returns the mean Fisher-z of those correlations and the
+    one-sided p-value of a t-test over (condition, channel) pairs that it is > 0.
     """
     from scipy import stats
 
     zs = []
+    n_ch = residual.shape[-1]
     cond = info["gait"].astype(str) + "|" + info["frequency_hz"].round(6).astype(str)
     pbin = _phase_bins(phase)
     for c in np.unique(cond):
@@ -149,8 +152,8 @@ def systematic_gap(
             sel = (cond == c).to_numpy() & np.isin(info["trial_id"].to_numpy(), h)
             if not sel.any():
                 break
-            r, b = residual[sel].reshape(-1, 3), pbin[sel].reshape(-1)
-            m = np.full((N_PHASE_BINS, 3), np.nan)
+            r, b = residual[sel].reshape(-1, n_ch), pbin[sel].reshape(-1)
+            m = np.full((N_PHASE_BINS, n_ch), np.nan)
             for k in range(N_PHASE_BINS):
                 hit = (b == k) & np.all(np.isfinite(r), axis=1)
                 if hit.any():
@@ -158,7 +161,7 @@ def systematic_gap(
             prof.append(m)
         if len(prof) < 2:
             continue
-        for ch in range(3):
+        for ch in range(n_ch):
             a, b2 = prof[0][:, ch], prof[1][:, ch]
             ok = np.isfinite(a) & np.isfinite(b2)
             if ok.sum() > 3 and a[ok].std() > 0 and b2[ok].std() > 0:

@@ -530,9 +530,10 @@ def explain_gap(
     with the signals and try a learned correction (with the partial effects' features)."""
     partial = partial or []
     step.decision = "none_significant"
-    residual = (sim - w.measured)[..., :3]
+    residual = sim - w.measured
     # systematic = the residual's phase profile repeats across independent halves
     step.systematic = systematic_gap(residual, w.phase, w.full.info, (w.train_ids, w.test_ids))
+    residual = residual[..., :3]
     gap = step.systematic[1] < opts.alpha and step.test_loss > opts.gap_floor
     if not (gap or partial):
         return
