@@ -172,7 +172,7 @@ def withheld_summary(table: pd.DataFrame) -> pd.DataFrame:
                 "median_gap_closed": float(np.median(closed)),
                 "closed_ge_50pct": float(np.mean(closed >= 0.5)),
                 "physics_match": float((g["physics"] == g["expected"]).mean())
-                if g["expected"].fillna("").ne("").all()
+                if g["expected"].notna().all() and g["expected"].astype(str).ne("").all()
                 else np.nan,
                 "leading_features": ", ".join(
                     f"{k} ({v})" for k, v in lead[lead != ""].value_counts().items()
