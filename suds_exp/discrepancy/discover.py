@@ -353,11 +353,12 @@ def effect_constancy(
 ) -> Constancy:
     """Test that a just-named effect has one strength everywhere.
 
-    ``Xe`` (n_windows, n_samples, n_channels, 4) is `features.effect_features` of the
-    effect: its contribution D and D times distance, time and forward-sliding. On the
-    training trials, per channel, the remainder ``meas - sim`` (``sim`` is the replay with
-    the effect) is regressed by least squares once on D alone (a constant re-scaling of
-    the effect: absorbs a slightly mis-fitted parameter) and once on all four. On the
+    ``Xe`` (n_windows, n_samples, n_channels, n) is `features.effect_features` of the
+    effect: its contribution D and D times distance, time and each segment sliding
+    forward. On the training trials, per channel, the remainder ``meas - sim`` (``sim``
+    is the replay with the effect) is regressed by least squares once on D alone (a
+    constant re-scaling of the effect: absorbs a slightly mis-fitted parameter) and once
+    on all of them. On the
     held-out trials, the one-sided paired t-test that the varying fit removes more than
     ``min_improvement`` of the constant fit's loss, at ``alpha``. A significant result
     means the data want the effect stronger in some parts and weaker in others: the

@@ -232,29 +232,39 @@ def channel_features(windows: WindowSet, sim: np.ndarray) -> tuple[np.ndarray, l
 
 
 def effect_features(
-    windows: WindowSet, samples: pd.DataFrame, sim: np.ndarray, delta: np.ndarray, label: str
+    windows: WindowSet,
+    samples: pd.DataFrame,
+    sim: np.ndarray,
+    delta: np.ndarray,
+    label: str,
+    half_middle_mm: float,
 ) -> tuple[np.ndarray, list[Feature]]:
     """Does a named effect's strength vary? Its contribution times distance, time, direction.
 
     ``delta`` is what the named effect adds to every channel (the replay with it minus
     the replay without it, same shape as ``sim``). A physical constant has the same
     strength everywhere; an effect that only mimics the real one is too weak in some
-    parts of the data and too strong in others. The three covariates are the ones a
-    constant drag/inertia parameter could physically depend on: distance travelled (a
-    bed that compacts), time in the trial (drift: warming, wear) and the direction the
-    body slides (drag that differs forward and backward). ``delta`` itself is in the set
-    so that a slightly mis-fitted but constant parameter is absorbed there.
+    parts of the data and too strong in others. The covariates are the ones a constant
+    drag/inertia parameter could physically depend on: distance travelled (a bed that
+    compacts), time in the trial (drift: warming, wear) and the direction each segment
+    slides along its own axis (drag that differs forward and backward acts per segment,
+    and the outer segments often slide against the body: `segment_sliding`).
+    ``delta`` itself is in the set so that a slightly mis-fitted but constant parameter
+    is absorbed there. ``half_middle_mm``: half the middle segment's length, mm (the
+    motor axes' offset from the body origin).
 
     Returns
     -------
-    Xc : array (n_windows, n_samples, n_channels, 4)
-    features : `Feature` s named after ``label`` (coefficients in 1, 1/m, 1/s, 1)
+    Xc : array (n_windows, n_samples, n_channels, 6)
+    features : `Feature` s named after ``label`` (coefficients in 1, 1/m, 1/s, 1, 1, 1)
     """
     t = window_field(windows, "t")
     dist, t_trial = _distance_and_time(windows, samples)
-    fwd = (sim[..., :1] > 0).astype(float)
+    fwd = segment_sliding(sim[..., :3], window_field(windows, "ra"), half_middle_mm) > 0
     Xc = np.stack(
-        [delta, dist[..., None] * delta, t_trial[..., None] * delta, fwd * delta], axis=-1
+        [delta, dist[..., None] * delta, t_trial[..., None] * delta]
+        + [fwd[..., i, None] * delta for i in range(3)],
+        axis=-1,
     )
     Xc[~np.isfinite(t)] = np.nan
     d = f"D[{label}]"
@@ -263,7 +273,30 @@ def effect_features(
         Feature(f"s*{d}", f"m {IN_CHANNEL_UNIT}", "distance"),
         Feature(f"t*{d}", f"s {IN_CHANNEL_UNIT}", "time"),
         Feature(f"[v_x>0]*{d}", IN_CHANNEL_UNIT, "sign"),
+        Feature(f"[u_head>0]*{d}", IN_CHANNEL_UNIT, "sign"),
+        Feature(f"[u_tail>0]*{d}", IN_CHANNEL_UNIT, "sign"),
     ]
+
+
+def segment_sliding(v: np.ndarray, ra: np.ndarray, half_middle_mm: float) -> np.ndarray:
+    """Each segment's velocity along its own axis, towards the head (mm/s).
+
+    A rigid segment has one tangential velocity along its whole length: turning about its
+    joint moves its points normal to the axis only. With the body velocity ``v`` = (vx,
+    vy, wz) (mm/s, mm/s, rad/s) and r_a = (phi1, phi2) (rad; the head axis at +phi1 from
+    body X, the tail axis at -phi2, joints at +-``half_middle_mm`` on body X):
+
+    - middle: u = vx
+    - head: u = vx cos phi1 + vy sin phi1 + wz a sin phi1
+    - tail: u = vx cos phi2 - vy sin phi2 + wz a sin phi2
+
+    ``v`` (..., 3), ``ra`` (..., >= 2); returns (..., 3): middle, head, tail.
+    """
+    vx, vy, wz = v[..., 0], v[..., 1], v[..., 2]
+    c1, s1 = np.cos(ra[..., 0]), np.sin(ra[..., 0])
+    c2, s2 = np.cos(ra[..., 1]), np.sin(ra[..., 1])
+    a = half_middle_mm
+    return np.stack([vx, vx * c1 + vy * s1 + wz * a * s1, vx * c2 - vy * s2 + wz * a * s2], axis=-1)
 
 
 def _distance_and_time(windows: WindowSet, samples: pd.DataFrame):

@@ -7,7 +7,7 @@ recognised by its strength not being constant: the data want it stronger in some
 and weaker in others. After an effect is added, the next replay gives its contribution
 D (replay with it minus replay without it, no extra replay) and
 `discover.effect_constancy` tests on held-out trials whether letting D vary with
-distance, time or sliding direction removes a material part of what remains. If it does,
+distance, time or a segment's sliding direction removes a material part of what remains. If it does,
 the effect is kept in the model but reported as a *partial* explanation (step decision
 ``partial``), the remaining gap counts as unexplained by the library, and the learned
 correction is fitted to it with D and its variations among the features, so the report
@@ -34,16 +34,20 @@ def check_named(
     scales: np.ndarray,
     train_ids,
     opts,
+    half_middle_mm: float,
 ) -> list[tuple[np.ndarray, list]]:
     """Test the effect ``step`` accepted; set ``step.constancy`` and, when its strength
     is not constant, ``step.decision = "partial"``.
 
     ``sim_before`` / ``sim_after``: the full-rate replays (n_windows, n_samples,
-    n_channels) without and with the effect. Returns ``[(Xe, features)]`` for the learned
+    n_channels) without and with the effect; ``half_middle_mm``: the model's half middle
+    segment, mm (for each segment's sliding direction). Returns ``[(Xe, features)]`` for the learned
     correction when the effect is partial, else ``[]``.
     """
     label = step.accepted.candidate.label
-    Xe, feats = effect_features(full, samples, sim_after, sim_after - sim_before, label)
+    Xe, feats = effect_features(
+        full, samples, sim_after, sim_after - sim_before, label, half_middle_mm
+    )
     step.constancy = effect_constancy(
         Xe,
         feats,

@@ -635,7 +635,16 @@ def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
         )
         if prev_sim is not None and steps[-2].accepted is not None:
             partial += check_named(
-                steps[-2], prev_sim, sim, w.full, w.samples, w.measured, w.scales, w.train_ids, opts
+                steps[-2],
+                prev_sim,
+                sim,
+                w.full,
+                w.samples,
+                w.measured,
+                w.scales,
+                w.train_ids,
+                opts,
+                model.geometry.middle_length_mm / 2,
             )
             c = steps[-2].constancy
             say(
