@@ -19,7 +19,6 @@ from suds_exp.robot import sample_columns
 __all__ = [
     "DEFAULTS",
     "Differentiator",
-
     "PRESETS",
     "Phaser",
     "PrepResult",
