@@ -7,11 +7,11 @@ recognised by its strength not being constant: the data want it stronger in some
 and weaker in others. After an effect is added, the next replay gives its contribution
 D (replay with it minus replay without it, no extra replay) and
 `discover.effect_constancy` tests on held-out trials whether letting D vary with
-distance, time or a segment's sliding direction removes a material part of what remains. If it does,
-the effect is kept in the model but reported as a *partial* explanation (step decision
-``partial``), the remaining gap counts as unexplained by the library, and the learned
-correction is fitted to it with D and its variations among the features, so the report
-says how much each part closed.
+distance, time or a segment's sliding direction removes a material part of what
+remains. If it does, the effect is kept in the model but reported as a *partial*
+explanation (step decision ``partial``), the remaining gap counts as unexplained by the
+library, and the learned correction is fitted to it with D and its variations among the
+features, so the report says how much each part closed.
 """
 
 from __future__ import annotations
