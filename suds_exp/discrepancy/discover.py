@@ -354,16 +354,15 @@ def effect_constancy(
     """Test that a just-named effect has one strength everywhere.
 
     ``Xe`` (n_windows, n_samples, n_channels, n) is `features.effect_features` of the
-    effect: its contribution D and D times distance, time and each segment sliding
-    forward. On the training trials, per channel, the remainder ``meas - sim`` (``sim``
-    is the replay with the effect) is regressed by least squares once on D alone (a
-    constant re-scaling of the effect: absorbs a slightly mis-fitted parameter) and once
-    on all of them. On the
-    held-out trials, the one-sided paired t-test that the varying fit removes more than
-    ``min_improvement`` of the constant fit's loss, at ``alpha``. A significant result
-    means the data want the effect stronger in some parts and weaker in others: the
-    effect mimics something the library does not hold, and is reported as a partial
-    explanation, not as the cause.
+    effect: its contribution D and D times distance, time, each segment sliding forward
+    and each condition. On the training trials, per channel, the remainder ``meas - sim``
+    (``sim`` is the replay with the effect) is regressed by least squares once on D
+    alone (a constant re-scaling of the effect: absorbs a slightly mis-fitted parameter)
+    and once on all of them. On the held-out trials, the one-sided paired t-test that the
+    varying fit removes more than ``min_improvement`` of the constant fit's loss, at
+    ``alpha``. A significant result means the data want the effect stronger in some
+    parts and weaker in others: the effect mimics something the library does not hold,
+    and is reported as a partial explanation, not as the cause.
     """
     n_win, n_s, n_ch, n_e = Xe.shape
     is_train = np.isin(trial_id, np.asarray(list(train_trials)))

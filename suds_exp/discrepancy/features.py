@@ -48,6 +48,7 @@ PHYSICS: dict[str, str] = {
     "product": "shape-dependent force",
     "constant": "offset",
     "effect": "the named effect's own scale",
+    "condition": "a named effect whose strength differs between gaits and frequencies",
 }
 
 #: Units of the replayed channels (vx, vy, wz, then passive-shape coordinates).
@@ -248,22 +249,30 @@ def effect_features(
     drag/inertia parameter could physically depend on: distance travelled (a bed that
     compacts), time in the trial (drift: warming, wear) and the direction each segment
     slides along its own axis (drag that differs forward and backward acts per segment,
-    and the outer segments often slide against the body: `segment_sliding`).
-    ``delta`` itself is in the set so that a slightly mis-fitted but constant parameter
-    is absorbed there. ``half_middle_mm``: half the middle segment's length, mm (the
-    motor axes' offset from the body origin).
+    and the outer segments often slide against the body: `segment_sliding`) and the
+    condition (gait and frequency: `condition_labels`). The candidate's own physics
+    already says how its contribution changes from gait to gait and with the gait's
+    speed (a viscous torque grows with the rates, a granular force does not), so a
+    real effect needs no rescaling per condition, while a mimic of another form does
+    (hinge damping standing in for locked flippers). ``delta`` itself is in the set so
+    that a slightly mis-fitted but constant parameter is absorbed there.
+    ``half_middle_mm``: half the middle segment's length, mm (the motor axes' offset
+    from the body origin).
 
     Returns
     -------
-    Xc : array (n_windows, n_samples, n_channels, 6)
-    features : `Feature` s named after ``label`` (coefficients in 1, 1/m, 1/s, 1, 1, 1)
+    Xc : array (n_windows, n_samples, n_channels, 6 + n_conditions - 1)
+    features : `Feature` s named after ``label`` (coefficients in 1, 1/m, 1/s, then 1)
     """
     t = window_field(windows, "t")
     dist, t_trial = _distance_and_time(windows, samples)
     fwd = segment_sliding(sim[..., :3], window_field(windows, "ra"), half_middle_mm) > 0
+    cond = condition_labels(windows.info)
+    levels = sorted(set(cond))[1:]  # the first condition is D's own column
     Xc = np.stack(
         [delta, dist[..., None] * delta, t_trial[..., None] * delta]
-        + [fwd[..., i, None] * delta for i in range(3)],
+        + [fwd[..., i, None] * delta for i in range(3)]
+        + [(cond == c)[:, None, None] * delta for c in levels],
         axis=-1,
     )
     Xc[~np.isfinite(t)] = np.nan
@@ -275,7 +284,14 @@ def effect_features(
         Feature(f"[v_x>0]*{d}", IN_CHANNEL_UNIT, "sign"),
         Feature(f"[u_head>0]*{d}", IN_CHANNEL_UNIT, "sign"),
         Feature(f"[u_tail>0]*{d}", IN_CHANNEL_UNIT, "sign"),
-    ]
+    ] + [Feature(f"[{c}]*{d}", IN_CHANNEL_UNIT, "condition") for c in levels]
+
+
+def condition_labels(info: pd.DataFrame) -> np.ndarray:
+    """Each window's condition, ``gait@frequency`` (frequency in Hz to 4 places; a trial
+    without a frequency counts as its own condition ``gait@nan``)."""
+    freq = info["frequency_hz"].astype(float).round(4).astype(str)
+    return (info["gait"].astype(str) + "@" + freq).to_numpy()
 
 
 def segment_sliding(v: np.ndarray, ra: np.ndarray, half_middle_mm: float) -> np.ndarray:

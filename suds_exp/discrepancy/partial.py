@@ -7,11 +7,11 @@ recognised by its strength not being constant: the data want it stronger in some
 and weaker in others. After an effect is added, the next replay gives its contribution
 D (replay with it minus replay without it, no extra replay) and
 `discover.effect_constancy` tests on held-out trials whether letting D vary with
-distance, time or a segment's sliding direction removes a material part of what
-remains. If it does, the effect is kept in the model but reported as a *partial*
-explanation (step decision ``partial``), the remaining gap counts as unexplained by the
-library, and the learned correction is fitted to it with D and its variations among the
-features, so the report says how much each part closed.
+distance, time, a segment's sliding direction or the condition (gait and frequency)
+removes a material part of what remains. If it does, the effect is kept in the model
+but reported as a *partial* explanation (step decision ``partial``), the remaining gap
+counts as unexplained by the library, and the learned correction is fitted to it with D
+and its variations among the features, so the report says how much each part closed.
 """
 
 from __future__ import annotations
@@ -41,8 +41,10 @@ def check_named(
 
     ``sim_before`` / ``sim_after``: the full-rate replays (n_windows, n_samples,
     n_channels) without and with the effect; ``half_middle_mm``: the model's half middle
-    segment, mm (for each segment's sliding direction). Returns ``[(Xe, features)]`` for the learned
-    correction when the effect is partial, else ``[]``.
+    segment, mm (for each segment's sliding direction). Returns ``[(Xe, features)]`` for
+    the learned correction when the effect is partial, else ``[]``: D and its variations
+    along distance, time and sliding direction, which are forms of physics; the
+    per-condition scales test the form but name no mechanism, so they stay out of it.
     """
     label = step.accepted.candidate.label
     Xe, feats = effect_features(
@@ -63,7 +65,8 @@ def check_named(
     if not step.constancy.significant:
         return []
     step.decision = "partial"
-    return [(Xe, feats)]
+    physical = [i for i, f in enumerate(feats) if f.family != "condition"]
+    return [(Xe[..., physical], [feats[i] for i in physical])]
 
 
 def discover_step(
