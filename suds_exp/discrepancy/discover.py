@@ -330,7 +330,7 @@ class Constancy:
     test_after: np.ndarray
     p_value: float
     significant: bool
-    varies_with: str  # family of the largest varying term: distance | time | sign
+    varies_with: str  # family of the largest varying term: distance|time|sign|condition
 
     @property
     def improvement(self) -> float:

@@ -48,7 +48,6 @@ PHYSICS: dict[str, str] = {
     "product": "shape-dependent force",
     "constant": "offset",
     "effect": "the named effect's own scale",
-    "condition": "a named effect whose strength differs between gaits and frequencies",
 }
 
 #: Units of the replayed channels (vx, vy, wz, then passive-shape coordinates).
@@ -240,7 +239,8 @@ def effect_features(
     label: str,
     half_middle_mm: float,
 ) -> tuple[np.ndarray, list[Feature]]:
-    """Does a named effect's strength vary? Its contribution times distance, time, direction.
+    """Does a named effect's strength vary? Its contribution by distance, time, direction,
+    condition.
 
     ``delta`` is what the named effect adds to every channel (the replay with it minus
     the replay without it, same shape as ``sim``). A physical constant has the same
