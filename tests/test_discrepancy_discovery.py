@@ -196,19 +196,26 @@ def test_segment_sliding_is_each_segment_velocity_along_its_axis():
         np.testing.assert_allclose(u, along, atol=1e-4 * np.abs(along).max())
 
 
-@pytest.mark.slow
-def test_a_drag_scale_standing_in_for_asymmetric_drag_is_partial(tmp_path):
-    """Asymmetric drag hidden and withheld (benchmarks/discrepancy.py --withheld, seed
-    100): a constant drag scale closes most of the gap but the strength the data want
-    from it is not constant, so it is kept as a partial explanation and no cause is
-    named. Before the per-segment covariates drag_anisotropy was named the cause."""
+def _withheld(effect: str, seed: int, workdir):
+    """``effect`` hidden in the data and excluded from the candidates, as
+    `benchmarks/discrepancy.py --withheld` runs it at ``seed`` (its design is
+    `hidden_effect_run`'s default: 3 gaits x 3 frequencies x 4 repeats, 4-6 cycles)."""
     from suds_exp.discrepancy import DiscrepancyOptions
     from suds_exp.testing.hidden_effects import draw_hidden, hidden_effect_run
 
-    hidden = {"asymmetric_drag": draw_hidden("asymmetric_drag", np.random.default_rng(100))}
-    opts = DiscrepancyOptions(seed=100, exclude=("asymmetric_drag",))
-    sweep = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4)
-    res = hidden_effect_run(hidden, seed=100, options=opts, workdir=tmp_path, **sweep).result
+    hidden = {effect: draw_hidden(effect, np.random.default_rng(seed))}
+    opts = DiscrepancyOptions(seed=seed, exclude=(effect,))
+    return hidden, hidden_effect_run(hidden, seed=seed, options=opts, workdir=workdir)
+
+
+@pytest.mark.slow
+def test_a_drag_scale_standing_in_for_asymmetric_drag_is_partial(tmp_path):
+    """Asymmetric drag hidden and withheld (seed 100): a constant drag scale closes most
+    of the gap but the strength the data want from it is not constant, so it is kept as
+    a partial explanation and no cause is named. Before the per-segment covariates
+    drag_anisotropy was named the cause."""
+    _, run = _withheld("asymmetric_drag", 100, tmp_path)
+    res = run.result
     assert [n["candidate"] for n in res.named if n["role"] == "cause"] == [], res.outcome
     (partial,) = [n for n in res.named if n["role"] == "partial"]
     assert partial["candidate"] == "drag_anisotropy"
@@ -217,18 +224,13 @@ def test_a_drag_scale_standing_in_for_asymmetric_drag_is_partial(tmp_path):
 @pytest.mark.slow
 def test_hinge_damping_standing_in_for_locked_flippers_is_partial(tmp_path):
     """Flippers locked in the data (71 deg), free in the model and withheld from the
-    candidates (benchmarks/discrepancy.py --withheld, seed 100): hinge damping closes
-    part of the gap, but the strength the data want differs from gait to gait and
-    frequency to frequency, so it is kept as a partial explanation, not named the cause.
-    Before the per-condition covariates it was named the cause."""
-    from suds_exp.discrepancy import DiscrepancyOptions
-    from suds_exp.testing.hidden_effects import draw_hidden, hidden_effect_run
-
-    hidden = {"flippers": draw_hidden("flippers", np.random.default_rng(100))}
+    candidates (seed 100): hinge damping closes part of the gap, but the strength the
+    data want differs from gait to gait and frequency to frequency, so it is kept as a
+    partial explanation, not named the cause. Before the per-condition covariates it was
+    named the cause."""
+    hidden, run = _withheld("flippers", 100, tmp_path)
     assert hidden["flippers"]["mode"] == "locked"
-    opts = DiscrepancyOptions(seed=100, exclude=("flippers",))
-    sweep = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4)
-    res = hidden_effect_run(hidden, seed=100, options=opts, workdir=tmp_path, **sweep).result
+    res = run.result
     assert [n["candidate"] for n in res.named if n["role"] == "cause"] == [], res.outcome
     assert res.named[0]["candidate"] == "hinge_damping" and res.named[0]["role"] == "partial"
     assert res.steps[0].constancy.varies_with == "condition"

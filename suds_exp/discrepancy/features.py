@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 from scipy.signal import savgol_filter
 
+from suds_exp.campaign.conditions import format_condition, round_hz
 from suds_exp.discrepancy.replay import WindowSet, window_field
 
 #: Physics a term of each feature family most resembles. The mapping is the form each
@@ -250,7 +251,7 @@ def effect_features(
     compacts), time in the trial (drift: warming, wear) and the direction each segment
     slides along its own axis (drag that differs forward and backward acts per segment,
     and the outer segments often slide against the body: `segment_sliding`) and the
-    condition (gait and frequency: `condition_labels`). The candidate's own physics
+    condition (gait and frequency). The candidate's own physics
     already says how its contribution changes from gait to gait and with the gait's
     speed (a viscous torque grows with the rates, a granular force does not), so a
     real effect needs no rescaling per condition, while a mimic of another form does
@@ -267,8 +268,11 @@ def effect_features(
     t = window_field(windows, "t")
     dist, t_trial = _distance_and_time(windows, samples)
     fwd = segment_sliding(sim[..., :3], window_field(windows, "ra"), half_middle_mm) > 0
-    cond = condition_labels(windows.info)
-    levels = sorted(set(cond))[1:]  # the first condition is D's own column
+    info = windows.info
+    # the campaign's spelling of a condition ("O@0.5"); the first one is D's own column
+    pairs = zip(info["gait"], info["frequency_hz"], strict=True)
+    cond = np.array([format_condition((g, round_hz(f))) for g, f in pairs])
+    levels = sorted(set(cond))[1:]
     Xc = np.stack(
         [delta, dist[..., None] * delta, t_trial[..., None] * delta]
         + [fwd[..., i, None] * delta for i in range(3)]
@@ -285,13 +289,6 @@ def effect_features(
         Feature(f"[u_head>0]*{d}", IN_CHANNEL_UNIT, "sign"),
         Feature(f"[u_tail>0]*{d}", IN_CHANNEL_UNIT, "sign"),
     ] + [Feature(f"[{c}]*{d}", IN_CHANNEL_UNIT, "condition") for c in levels]
-
-
-def condition_labels(info: pd.DataFrame) -> np.ndarray:
-    """Each window's condition, ``gait@frequency`` (frequency in Hz to 4 places; a trial
-    without a frequency counts as its own condition ``gait@nan``)."""
-    freq = info["frequency_hz"].astype(float).round(4).astype(str)
-    return (info["gait"].astype(str) + "@" + freq).to_numpy()
 
 
 def segment_sliding(v: np.ndarray, ra: np.ndarray, half_middle_mm: float) -> np.ndarray:
