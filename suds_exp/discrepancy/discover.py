@@ -28,12 +28,11 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import stats
 from sklearn.linear_model import orthogonal_mp
 from sklearn.model_selection import GroupKFold
 
 from suds_exp.discrepancy.features import IN_CHANNEL_UNIT, PHYSICS, Feature, channel_unit
-from suds_exp.discrepancy.fit_candidates import trial_losses
+from suds_exp.discrepancy.fit_candidates import held_out_p, trial_losses
 from suds_exp.errors import DiscrepancyError
 
 
@@ -302,21 +301,10 @@ def discover(
         np.stack([sim[test], corrected]), meas[test], scales, trial_id[test]
     )
     out.test_trials, out.test_before, out.test_after = trials, loss[0], loss[1]
-    out.p_value = _held_out_p(loss[0], loss[1], min_improvement) if terms else 1.0
+    out.p_value = held_out_p(loss[0], loss[1], min_improvement) if terms else 1.0
     out.significant = out.p_value < alpha
     out.seconds = time.perf_counter() - started
     return out
-
-
-def _held_out_p(before: np.ndarray, after: np.ndarray, margin: float) -> float:
-    """One-sided paired t-test over held-out trials that 1 - after / before > margin."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        d = 1.0 - after / before
-    if len(d) < 2 or not np.all(np.isfinite(d)):
-        return 1.0
-    if np.allclose(d, d[0]):
-        return 0.0 if d[0] > margin else 1.0
-    return float(stats.ttest_1samp(d, margin, alternative="greater").pvalue)
 
 
 @dataclass
@@ -385,7 +373,7 @@ def effect_constancy(
     corr = corr.reshape(2, n_win, n_s, n_ch)
     test = ~is_train
     trials, loss = trial_losses(sim[None, test] + corr[:, test], meas[test], scales, trial_id[test])
-    p = _held_out_p(loss[0], loss[1], min_improvement)
+    p = held_out_p(loss[0], loss[1], min_improvement)
     varying = share[1:]
     fam = features[1 + int(np.argmax(varying))].family if varying.any() else ""
     return Constancy(effect, loss[0], loss[1], p, p < alpha, fam)

@@ -8,7 +8,10 @@ bootstrap replicate is one matrix product), a confidence interval for it.
 
 Scores are per trial (mean over its windows), so every test is over trials, never over
 samples: the paired test compares the held-out trials' losses before and after adding
-the candidate.
+the candidate. The candidates are tested in the order of their training loss, each at the
+full level until the first one fails (a fixed-sequence procedure: the order comes from
+trials the held-out test never sees, so the family-wise error stays at alpha without a
+Bonferroni factor).
 """
 
 from __future__ import annotations
@@ -224,6 +227,22 @@ def refine_candidate(
     return res
 
 
+def held_out_p(before: np.ndarray, after: np.ndarray, margin: float) -> float:
+    """One-sided paired t-test over held-out trials that 1 - after / before > margin.
+
+    before, after : arrays (n_trials,) of per-trial losses. The relative reduction (at
+    most 1) keeps a trial the change fixes completely from dominating the test the way
+    a log ratio would. Fewer than two trials, or a non-finite reduction, give 1.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = 1.0 - after / before
+    if len(d) < 2 or not np.all(np.isfinite(d)):
+        return 1.0
+    if np.allclose(d, d[0]):
+        return 0.0 if d[0] > margin else 1.0
+    return float(stats.ttest_1samp(d, margin, alternative="greater").pvalue)
+
+
 def score_candidates(
     results: list[CandidateResult],
     base: SimConfig,
@@ -234,29 +253,39 @@ def score_candidates(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Score every fitted candidate on the held-out windows, in one simulator call.
 
-    Fills each result's test losses and its one-sided paired t-test over held-out
-    trials that the relative loss reduction 1 - loss_after / loss_before exceeds
-    ``min_improvement``, Bonferroni corrected for the number of candidates. The relative
-    reduction (at most 1) keeps a trial the candidate fixes completely from dominating
-    the test the way a log ratio would. Returns (test trial ids, base losses).
+    Fills each result's test losses and raw p-value (`held_out_p`, margin
+    ``settings.min_improvement``), then its adjusted p-value and decision at ``alpha``
+    (`adjust_in_training_order`: the results' ``train_after`` must be filled). Returns
+    (test trial ids, base losses).
     """
     started = time.perf_counter()
     trials, loss = _loss_on(test, [base] + [r.config for r in results], scales)
     share = (time.perf_counter() - started) / max(len(results), 1)
-    margin = settings.min_improvement
     for k, r in enumerate(results):
         r.test_trials, r.test_before, r.test_after = trials, loss[0], loss[k + 1]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            d = 1.0 - loss[k + 1] / loss[0]
-        if len(d) < 2 or not np.all(np.isfinite(d)):
-            p = 1.0 if not np.all(np.isfinite(d)) else float(d.mean() <= margin)
-        elif np.allclose(d, d[0]):
-            p = 0.0 if d[0] > margin else 1.0
-        else:
-            p = float(stats.ttest_1samp(d, margin, alternative="greater").pvalue)
-        r.p_value = p
-        r.p_adjusted = min(1.0, p * len(results))
-        r.significant = r.p_adjusted < alpha
+        r.p_value = held_out_p(loss[0], loss[k + 1], settings.min_improvement)
         r.n_replays += len(test.info)
         r.seconds += share
+    adjust_in_training_order(results, alpha)
     return trials, loss[0]
+
+
+def adjust_in_training_order(results: list[CandidateResult], alpha: float) -> None:
+    """Fixed-sequence test of the candidates, in place.
+
+    The candidates are ordered by their training loss (``train_after``, lowest first; a
+    missing one last) and tested one after another at ``alpha`` until the first that
+    fails: a candidate's adjusted p-value is the largest raw p-value up to it in that
+    order. The order uses only training trials, disjoint from the held-out ones the raw
+    p-values come from, so the chance of calling any candidate significant when none
+    helps stays at ``alpha`` for any number of candidates, while the one the training
+    trials point to is not penalised for the others (Bonferroni would multiply its p by
+    their number).
+    """
+    key = [(np.isnan(r.train_after), r.train_after, r.candidate.label) for r in results]
+    running = 0.0
+    for k in sorted(range(len(results)), key=key.__getitem__):
+        r = results[k]
+        running = max(running, r.p_value)
+        r.p_adjusted = running
+        r.significant = running < alpha

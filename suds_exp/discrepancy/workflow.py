@@ -53,7 +53,8 @@ class DiscrepancyOptions:
     Parameters
     ----------
     alpha : float
-        Level of the paired test naming an effect (Bonferroni over the candidates).
+        Level of the paired test naming an effect (the candidates tested in the order
+        of their training loss until one fails, `adjust_in_training_order`).
     max_effects : int
         Stop after naming this many effects.
     seed : int
@@ -507,13 +508,22 @@ def try_candidates(
         r = fit_candidate(c, current, w.train, w.scales, opts.fit, rng)
         step.candidates.append(r)
         say(f"  fitted {c.label}: {r.value} in {r.seconds:.1f} s")
-    if step.candidates:
-        score_candidates(step.candidates, current, w.test, w.scales, opts.alpha, opts.fit)
-        _, base_train = trial_losses(
-            replay(w.train, [current]), measured(w.train), w.scales, w.train.trial_id
-        )
-        for r in step.candidates:
-            r.train_before = float(base_train[0].mean())
+    if not step.candidates:
+        return
+    # the training losses order the held-out tests; a candidate with nothing to fit
+    # has none from its fit, so it is replayed here with the model itself
+    unfitted = [r for r in step.candidates if r.candidate.param is None]
+    _, train = trial_losses(
+        replay(w.train, [current] + [r.config for r in unfitted]),
+        measured(w.train),
+        w.scales,
+        w.train.trial_id,
+    )
+    for r in step.candidates:
+        r.train_before = float(train[0].mean())
+    for r, loss in zip(unfitted, train[1:], strict=True):
+        r.train_after = float(loss.mean())
+    score_candidates(step.candidates, current, w.test, w.scales, opts.alpha, opts.fit)
 
 
 def explain_gap(
