@@ -217,8 +217,8 @@ def test_a_drag_scale_standing_in_for_asymmetric_drag_is_partial(tmp_path):
     _, run = _withheld("asymmetric_drag", 100, tmp_path)
     res = run.result
     assert [n["candidate"] for n in res.named if n["role"] == "cause"] == [], res.outcome
-    (partial,) = [n for n in res.named if n["role"] == "partial"]
-    assert partial["candidate"] == "drag_anisotropy"
+    # the drag scale comes first; another candidate may follow it, also as partial
+    assert res.named[0]["candidate"] == "drag_anisotropy" and res.named[0]["role"] == "partial"
 
 
 @pytest.mark.slow
