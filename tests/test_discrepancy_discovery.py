@@ -234,3 +234,15 @@ def test_hinge_damping_standing_in_for_locked_flippers_is_partial(tmp_path):
     assert [n["candidate"] for n in res.named if n["role"] == "cause"] == [], res.outcome
     assert res.named[0]["candidate"] == "hinge_damping" and res.named[0]["role"] == "partial"
     assert res.steps[0].constancy.varies_with == "condition"
+
+
+@pytest.mark.slow
+def test_hinge_damping_pinned_at_the_top_of_its_range_is_not_the_cause(tmp_path):
+    """Flippers locked at 36 deg and withheld (seed 102): hinge damping closes 74 % of the
+    held-out gap with its strength constant enough (p 0.03), but only at 200 N mm s/rad,
+    the top of its realistic range; before the range-edge rule it was named the cause."""
+    _, run = _withheld("flippers", 102, tmp_path)
+    res = run.result
+    assert [n["candidate"] for n in res.named if n["role"] == "cause"] == [], res.outcome
+    assert res.named[0]["candidate"] == "hinge_damping" and res.named[0]["role"] == "partial"
+    assert res.steps[0].constancy.at_range_edge

@@ -167,6 +167,7 @@ def _record_discoveries(store, conn, run_id: int, result) -> None:
             "test_loss_constant": _num(np.mean(c.test_before)),
             "test_loss_varying": _num(np.mean(c.test_after)),
             "varies_with": c.varies_with,
+            "at_range_edge": bool(c.at_range_edge),
         }
         for s in result.steps
         if (c := getattr(s, "constancy", None)) is not None

@@ -231,6 +231,16 @@ def _discovery_parts(result, out: Path) -> list[str]:
     ]
 
 
+def _why_partial(step) -> str:
+    c, a = step.constancy, step.accepted
+    why = []
+    if c.significant:
+        why.append(f"its strength varies with {c.varies_with}, p = {c.p_value:.2g}")
+    if c.at_range_edge:
+        why.append(f"its fit, {a.value:.4g} {a.candidate.unit}, is at the edge of its range")
+    return "; ".join(why)
+
+
 def _shares(result) -> list[str]:
     """How much of the held-out gap each part closed: the effects named as partial
     explanations, then the learned correction (the form-mismatch case)."""
@@ -240,9 +250,8 @@ def _shares(result) -> list[str]:
     d = result.steps[-1].discovery
     g0 = result.gap_before
     parts = [
-        f"{s.accepted.candidate.label} (its strength varies with {s.constancy.varies_with}, "
-        f"p = {s.constancy.p_value:.2g}: a partial explanation, not the cause) closed "
-        f"{s.gap_closed:.0%} of the gap it was given"
+        f"{s.accepted.candidate.label} ({_why_partial(s)}: a partial explanation, not the "
+        f"cause) closed {s.gap_closed:.0%} of the gap it was given"
         for s in partial
     ]
     rest = (

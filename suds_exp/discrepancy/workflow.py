@@ -237,6 +237,7 @@ class DiscrepancyResult:
                     "systematic_p": s.systematic[1],
                     "varying_strength_p": s.constancy.p_value if s.constancy else None,
                     "varies_with": s.constancy.varies_with if s.constancy else None,
+                    "at_range_edge": s.constancy.at_range_edge if s.constancy else None,
                 }
                 for s in self.steps
             ],
@@ -659,7 +660,8 @@ def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
             c = steps[-2].constancy
             say(
                 f"  {c.effect}: {steps[-2].decision} (a varying strength removes "
-                f"{c.improvement:.0%} of the rest, p {c.p_value:.2g}, {c.varies_with})"
+                f"{c.improvement:.0%} of the rest, p {c.p_value:.2g}, {c.varies_with}"
+                f"{'; fit at the edge of its realistic range' if c.at_range_edge else ''})"
             )
         prev_sim = sim
         named = {s.accepted.candidate.effect for s in steps if s.accepted}
