@@ -18,8 +18,8 @@ by the discovered correction, and its leading features.
 `--detection EFFECT --values V1,V2,... --detection-seeds S1,S2,...`: the detection limit
 of one effect on the slow tests' design: the effect hidden at each fixed value of its
 parameter (no draw), run at each seed; per value it prints how often the effect is named
-first, the candidate's held-out p (raw and Bonferroni-adjusted), the held-out loss it
-removes, its fitted value and the gap. For example the spoke oscillation's edge:
+first, the candidate's held-out p (raw and adjusted for the other candidates), the
+held-out loss it removes, its fitted value and the gap. For example the spoke oscillation's edge:
 
     .venv/bin/python benchmarks/discrepancy.py --detection spoke_oscillation \
         --values 1.3,1.4,1.5 --detection-seeds 11,14,15 --out bench-detect.csv
