@@ -12,9 +12,9 @@ removes a material part of what remains. A second sign is a fit pinned at the ed
 the effect's realistic range: the data want more of it than the physics allows, so at
 any realistic strength it does not explain the gap. In either case the effect is kept
 in the model but reported as a *partial* explanation (step decision ``partial``), the
-remaining gap
-counts as unexplained by the library, and the learned correction is fitted to it with D
-and its variations among the features, so the report says how much each part closed.
+remaining gap counts as unexplained by the library, and the learned correction is fitted
+to it with D and its variations among the features, so the report says how much each
+part closed.
 """
 
 from __future__ import annotations
