@@ -1,5 +1,6 @@
 """Which candidates the held-out test calls significant (`adjust_in_training_order`), and
-which named ones are only partial because their fit is pinned at a range edge.
+which named ones are only partial because their fit is pinned at a range edge
+(`CandidateResult.at_range_edge`).
 
 The raw p-values come from the held-out trials; the order in which they are tested comes
 from the training trials alone. These tests build candidate results by hand, so they run
@@ -13,7 +14,6 @@ import pytest
 
 from suds_exp.discrepancy.effects import Candidate
 from suds_exp.discrepancy.fit_candidates import CandidateResult, adjust_in_training_order
-from suds_exp.discrepancy.partial import at_range_edge
 
 
 def _result(label: str, train_after: float, p: float) -> CandidateResult:
@@ -73,9 +73,9 @@ def _fitted(value: float | None, bounds=(0.0, 200.0), param: str | None = "dampi
 
 def test_a_fit_pinned_at_either_edge_of_its_realistic_range_is_at_the_edge():
     # locked flippers mimicked by hinge damping (seed 102) and a drag scale (seed 103)
-    assert at_range_edge(_fitted(200.0))
-    assert at_range_edge(_fitted(0.5, bounds=(0.5, 2.0)))
+    assert _fitted(200.0).at_range_edge
+    assert _fitted(0.5, bounds=(0.5, 2.0)).at_range_edge
     # hidden true effects near the top of their range (hit-rate runs) are not
-    assert not at_range_edge(_fitted(189.5))
-    assert not at_range_edge(_fitted(58.06, bounds=(0.0, 60.0)))
-    assert not at_range_edge(_fitted(None, param=None))
+    assert not _fitted(189.5).at_range_edge
+    assert not _fitted(58.06, bounds=(0.0, 60.0)).at_range_edge
+    assert not _fitted(None, param=None).at_range_edge

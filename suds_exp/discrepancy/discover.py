@@ -319,7 +319,7 @@ class Constancy:
     p_value: float
     significant: bool
     varies_with: str  # family of the largest varying term: distance|time|sign|condition
-    # the fit is pinned at the edge of the effect's realistic range (`partial.at_range_edge`)
+    # the fit is pinned at an edge of its realistic range (`CandidateResult.at_range_edge`)
     at_range_edge: bool = False
 
     @property

@@ -24,7 +24,6 @@ import pandas as pd
 
 from suds_exp.discrepancy.discover import Discovery, discover, effect_constancy
 from suds_exp.discrepancy.features import channel_features, effect_features, feature_library
-from suds_exp.discrepancy.fit_candidates import CandidateResult
 from suds_exp.discrepancy.replay import WindowSet
 
 
@@ -42,7 +41,7 @@ def check_named(
 ) -> list[tuple[np.ndarray, list]]:
     """Test the effect ``step`` accepted; set ``step.constancy`` and, when its strength
     is not constant or its fit is pinned at the edge of its realistic range
-    (`at_range_edge`), ``step.decision = "partial"``.
+    (`CandidateResult.at_range_edge`), ``step.decision = "partial"``.
 
     ``sim_before`` / ``sim_after``: the full-rate replays (n_windows, n_samples,
     n_channels) without and with the effect; ``half_middle_mm``: the model's half middle
@@ -67,30 +66,12 @@ def check_named(
         opts.fit.min_improvement,
         label,
     )
-    step.constancy.at_range_edge = at_range_edge(step.accepted)
+    step.constancy.at_range_edge = step.accepted.at_range_edge
     if not (step.constancy.significant or step.constancy.at_range_edge):
         return []
     step.decision = "partial"
     physical = [i for i, f in enumerate(feats) if f.family != "condition"]
     return [(Xe[..., physical], [feats[i] for i in physical])]
-
-
-def at_range_edge(result: CandidateResult, tol: float = 1e-3) -> bool:
-    """Is the fitted value at a bound of the candidate's realistic range?
-
-    The fit is bounded by the range, so a value on a bound (within ``tol`` of the range's
-    width) means the loss was still falling there: the data want the effect stronger than
-    it physically can be, and the effect at a realistic strength is not what the data
-    show. In the hit-rate benchmark no hidden effect's estimate came within 3 % of the
-    range of a bound; a locked flipper mimicked by hinge damping or a normal-drag scale
-    pins them at 200 N mm s/rad and 0.5. Candidates with nothing to fit are never at an
-    edge.
-    """
-    if result.candidate.param is None or result.value is None:
-        return False
-    lo, hi = result.candidate.bounds
-    margin = tol * (hi - lo)
-    return bool(result.value <= lo + margin or result.value >= hi - margin)
 
 
 def discover_step(
