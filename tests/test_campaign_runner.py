@@ -67,7 +67,7 @@ def test_a_campaign_fills_one_row_per_job(db, samples):
     (definition,) = store.query_df("SELECT definition FROM campaigns WHERE name = 'c'").definition
     stored = json.loads(definition)["options"]
     assert stored["boots"] == 2 and stored["sweep"] == [1, 2]
-    assert stored["models"]["phase-only"] == {"order": 6}
+    assert stored["models"]["phase-only"] == {"order": 10}
     status = campaign_status(store, "c")
     assert status["done"] == status["total"] == summary.total_jobs
     assert [m["done"] for m in status["models"]] == [summary.total_jobs // 2] * 2

@@ -130,3 +130,26 @@ def test_tls_stays_sane_with_very_few_cycles(n_cycles):
         rm[name] = np.sqrt(((pred["vx"] - test["vx"]) ** 2).mean())
     assert rm["TLS"] < 1.5 * rm["phase-only"]
     assert rm["TLS+SUDS"] < 1.5 * rm["phase-only"]
+
+
+def test_phase_only_is_tls_constant_term_at_the_same_phase_resolution():
+    """The paper defines phase-only as TLS's phase-dependent constant term: on a robot
+    whose shape never leaves its mean gait TLS has nothing else, so both must predict the
+    same, including the higher harmonics of v_b that flipper stops put there."""
+    t = np.arange(3000) * 0.01
+    phase = 2 * np.pi * 0.5 * t
+    ra = np.column_stack([np.cos(phase), np.sin(phase)])
+    dra = np.pi * np.column_stack([-np.sin(phase), np.cos(phase)])
+    vx = 20 + 15 * np.cos(2 * phase) + 4 * np.cos(6 * phase) + 2 * np.sin(8 * phase)
+    frame = pd.DataFrame(
+        {"trial_id": 1, "frame": np.arange(len(t)), "t": t, "phase": phase,
+         "ra_1": ra[:, 0], "ra_2": ra[:, 1], "dra_1": dra[:, 0], "dra_2": dra[:, 1],
+         "vx": vx, "vy": 0.1 * vx, "wz": 0.0}
+    )  # fmt: skip
+    assert make_model("phase-only").get_params()["order"] == make_model("TLS").get_params()[
+        "gait_order"
+    ]
+    phase_only = make_model("phase-only").fit(frame).predict(frame)["vx"]
+    tls = make_model("TLS").fit(frame).predict(frame)["vx"]
+    np.testing.assert_allclose(tls, phase_only, atol=1e-6 * np.abs(vx).max())
+    np.testing.assert_allclose(phase_only, vx, atol=1e-6 * np.abs(vx).max())

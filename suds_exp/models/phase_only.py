@@ -17,8 +17,9 @@ class PhaseOnly(Learner):
 
     Parameters
     ----------
-    order : int, default 6
-        Highest harmonic of the Fourier series (2 * order + 1 coefficients per output).
+    order : int, default `fourier.PHASE_ORDER` (10)
+        Highest harmonic of the Fourier series (2 * order + 1 coefficients per output);
+        the same default as TLS's ``gait_order``, whose constant term this is.
 
     Attributes
     ----------
@@ -28,7 +29,7 @@ class PhaseOnly(Learner):
 
     name = "phase-only"
 
-    def __init__(self, order: int = 6):
+    def __init__(self, order: int = fourier.PHASE_ORDER):
         self.order = order
 
     def fit(self, samples: pd.DataFrame, y=None) -> PhaseOnly:

@@ -146,8 +146,9 @@ class TLS(Learner):
         Number of phase bins (centres evenly spaced on [0, 2 pi)).
     bin_width : float, default 1.5
         Width of each bin's phase window, in units of the bin spacing (1 = disjoint).
-    gait_order : int, default 5
-        Fourier order of the mean gait r_bar(phase).
+    gait_order : int, default `fourier.PHASE_ORDER` (10)
+        Fourier order of the mean gait r_bar(phase) and of the outputs' phase mean (the
+        same default as phase-only, which is this model's constant term).
     coef_order : int, default 3
         Fourier order used to interpolate the bin coefficients over phase;
         2 * coef_order + 1 must not exceed n_bins.
@@ -185,7 +186,7 @@ class TLS(Learner):
         self,
         n_bins: int = 16,
         bin_width: float = 1.5,
-        gait_order: int = 5,
+        gait_order: int = fourier.PHASE_ORDER,
         coef_order: int = 3,
         min_bin_factor: float = 2.0,
         tls_gap: float = 2.0,
@@ -370,7 +371,7 @@ class TLSSuds(TLS):
         self,
         n_bins: int = 16,
         bin_width: float = 1.5,
-        gait_order: int = 5,
+        gait_order: int = fourier.PHASE_ORDER,
         coef_order: int = 3,
         min_bin_factor: float = 2.0,
         tls_gap: float = 2.0,
