@@ -116,7 +116,14 @@ def test_hinge_friction_differs_from_flipper_to_flipper():
 
 @pytest.mark.parametrize(
     "item",
-    ["servo.compliance_rad_per_n_m=2", "bed_heterogeneity.correlation_mm=5", "hinge_friction=-1"],
+    [
+        "servo.compliance_rad_per_n_m=2",
+        "bed_heterogeneity.correlation_mm=5",
+        "hinge_friction=-1",
+        "grain_contacts.cv=1.5",
+        "grain_contacts.correlation_mm=100",
+        "bed_depth.correlation_mm=10",
+    ],
 )
 def test_out_of_range_values_name_the_parameter_and_range(item):
     with pytest.raises(ConfigError, match=r"effects\.\w+\.\w+: .* outside its range"):
@@ -139,3 +146,84 @@ def test_default_design_leaves_48_cycles_outside_any_test_trial(seed):
     for counts in cycles.values():
         # each trial loses at most its partial first and last cycle
         assert sum(counts) - min(counts) - 2 * (len(counts) - 1) >= 48
+
+
+def test_bed_depth_leaves_a_rigid_robot_with_locked_flippers_unchanged():
+    # a common factor on every element's drag: quasi-static RFT is scale free
+    cmd = _command(0.5, 4.0)
+    rigid = set_effect(SimConfig(), "flippers=locked")
+    deep = set_effect(rigid, "bed_depth.cv=0.4")
+    a = simulate_prescribed(cmd, DT, rigid, commanded=True, trial_seeds=[(4, 1)])
+    b = simulate_prescribed(cmd, DT, deep, commanded=True, trial_seeds=[(4, 1)])
+    assert np.abs(a["pose"] - b["pose"]).max() < 1e-6
+
+
+def test_bed_depth_loads_compliant_servos_differently_along_the_tub():
+    cmd = _command(0.5, 8.0)
+    servo = set_effect(SimConfig(), "servo.compliance_rad_per_n_m=0.2")
+    deep = set_effect(servo, "bed_depth.cv=0.4")
+    lag = []
+    for cfg in (servo, deep):
+        out = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(4, 1)])
+        err = np.sqrt(((out["phi"] - cmd) ** 2).sum(axis=1))
+        cycles = err[: 4 * 200].reshape(4, 200).mean(axis=1)
+        lag.append(cycles)
+    # the servo lags by the same amount every cycle on a uniform bed, not on a varied one
+    assert np.ptp(lag[0][1:]) < 0.01
+    assert np.ptp(lag[1][1:]) > 3 * np.ptp(lag[0][1:])
+
+
+def test_bed_depth_field_is_a_body_scale_factor_of_mean_one():
+    cfg = set_effect(SimConfig(), "bed_depth.cv=0.3")
+    values = []
+    for seed in range(300):
+        modes, scale = draw_bed(cfg, (seed,))
+        values.append(bed_multiplier(modes, scale, np.zeros((2, 2)), body_xy=[50.0, -20.0])[0])
+        # without a local field the factor is the same at every element of the robot
+        spread = bed_multiplier(modes, scale, np.array([[-160.0, 0.0], [160.0, 0.0]]), [0, 0])
+        assert spread[0] == pytest.approx(spread[1])
+    values = np.array(values)
+    assert abs(values.mean() - 1.0) < 0.05
+    assert 0.22 < values.std() < 0.38
+
+
+def test_grain_contacts_are_deterministic_per_seed_and_absent_from_a_replay():
+    cmd = _command(0.5, 4.0)
+    cfg = set_effect(SimConfig(), "grain_contacts.cv=0.5")
+    a = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(2, 1)])
+    b = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(2, 1)])
+    c = simulate_prescribed(cmd, DT, cfg, commanded=True, trial_seeds=[(2, 2)])
+    assert np.array_equal(a["vel"], b["vel"])
+    assert np.abs(a["vel"] - c["vel"]).max() > 1.0
+    # a replay cannot know the grains a trial met: it sees the mean medium
+    replay = simulate_prescribed(cmd, DT, cfg)
+    nominal = simulate_prescribed(cmd, DT, SimConfig())
+    assert np.array_equal(replay["vel"], nominal["vel"])
+
+
+def test_grain_contacts_keep_the_motion_rate_independent():
+    # the contacts renew with slip distance, not time: the same shape path driven three
+    # times slower takes the body along the same path
+    cfg = set_effect(set_effect(SimConfig(), "grain_contacts.cv=0.5"), "flippers=locked")
+    t_fast = np.arange(301) * DT
+    t_slow = np.arange(901) * DT
+    fast = gait_shape("O", 2 * np.pi * 1.0 * t_fast)
+    slow = gait_shape("O", 2 * np.pi * (1 / 3) * t_slow)
+    a = simulate_prescribed(fast, DT, cfg, commanded=True, trial_seeds=[(9,)])
+    b = simulate_prescribed(slow, DT, cfg, commanded=True, trial_seeds=[(9,)])
+    end = np.abs(a["pose"][-1, :2] - b["pose"][-1, :2]).max()
+    travelled = np.abs(a["pose"][-1, :2] - a["pose"][0, :2]).max()
+    assert end < 0.03 * travelled
+    # and the fluctuations do move it: with the grains off the path differs
+    off = simulate_prescribed(fast, DT, set_effect(cfg, "grain_contacts=off"), commanded=True)
+    assert np.abs(off["pose"][-1, :2] - a["pose"][-1, :2]).max() > 5 * end
+
+
+def test_library_lists_the_new_effects_with_sourced_ranges():
+    lib = {e["name"]: e for e in effect_library()}
+    for name in ("grain_contacts", "bed_depth"):
+        assert lib[name]["replay"] == "mean"
+        assert lib[name]["nominal_state"] in ("on", "off")
+        main = next(p for p in lib[name]["parameters"] if p["name"] == lib[name]["main"])
+        assert main["range"][0] == 0.0 and main["range"][1] > 0
+        assert "(" in main["description"]  # a source in brackets

@@ -371,6 +371,75 @@ class HingeFrictionEffect:
 
 
 @dataclass
+class BedDepthEffect:
+    """The robot rests on the bed at a depth set by the beans' bearing under its whole
+    footprint, and a hand-levelled bed is denser in some places than others, so the
+    immersion depth changes as the robot travels. RFT stress grows with depth, so every
+    element's drag changes by one common factor (log-normal, mean 1) taken from a random
+    field over the tub at the body's position. A uniform factor leaves a rigid robot's
+    kinematics unchanged (RFT is scale free); it loads the servos and the flipper hinges.
+    Drawn anew for every trial from its seed."""
+
+    cv: float = field(
+        default=0.0,
+        metadata=_p(
+            "-",
+            0.0,
+            0.5,
+            "coefficient of variation of the drag from the immersion depth along the tub "
+            "(drag grows about as depth^2 for plates reaching from the surface, Maladen et "
+            "al. 2009; +-2-4 mm of a 20 mm immersion gives 0.2-0.4)",
+            main=True,
+            on=0.25,
+            off=0.0,
+        ),
+    )
+    correlation_mm: float = field(
+        default=200.0,
+        metadata=_p("mm", 50.0, 1000.0, "correlation length of the depth field over the tub"),
+    )
+
+
+@dataclass
+class GrainContactsEffect:
+    """Grain-scale fluctuations of the granular drag: the force chains in front of each
+    part of the robot jam and collapse as it slips through the beans (stick-slip), so
+    the drag on every RFT element is its mean times a log-normal factor of mean 1 that
+    changes over a slip distance of the order of a grain diameter (an Ornstein-Uhlenbeck
+    process in the element's own slip distance: rate independent), partly shared by the
+    elements of one segment or flipper. Drawn from the trial's seed."""
+
+    cv: float = field(
+        default=0.0,
+        metadata=_p(
+            "-",
+            0.0,
+            1.0,
+            "coefficient of variation of an element's drag (Albert et al. 2001 PRE "
+            "64 031307: stick-slip drag fluctuations of the order of the mean force; "
+            "Hossain & Rognon 2020: drops of up to 60 %)",
+            main=True,
+            on=0.4,
+            off=0.0,
+        ),
+    )
+    correlation_mm: float = field(
+        default=15.0,
+        metadata=_p(
+            "mm",
+            5.0,
+            40.0,
+            "slip distance over which the contacts renew: 0.5-4 grain diameters "
+            "(red beans 8-15 mm)",
+        ),
+    )
+    coherence: float = field(
+        default=0.5,
+        metadata=_p("-", 0.0, 1.0, "share of the log-variance common to a whole part"),
+    )
+
+
+@dataclass
 class Effects:
     """The named candidate effects; defaults are the nominal configuration."""
 
@@ -385,11 +454,18 @@ class Effects:
     bed_heterogeneity: BedHeterogeneityEffect = field(default_factory=BedHeterogeneityEffect)
     bed_packing: BedPackingEffect = field(default_factory=BedPackingEffect)
     hinge_friction: HingeFrictionEffect = field(default_factory=HingeFrictionEffect)
+    grain_contacts: GrainContactsEffect = field(default_factory=GrainContactsEffect)
+    bed_depth: BedDepthEffect = field(default_factory=BedDepthEffect)
 
 
 #: Effects drawn anew for every trial from its seed: a replay of measured joint angles
 #: cannot reproduce them sample by sample and simulates their mean (a uniform bed).
-PER_TRIAL_RANDOM_EFFECTS = ("bed_heterogeneity", "bed_packing")
+PER_TRIAL_RANDOM_EFFECTS = (
+    "bed_heterogeneity",
+    "bed_packing",
+    "grain_contacts",
+    "bed_depth",
+)
 #: Effects acting between the command and the joint angles: invisible when measured
 #: joint angles are replayed.
 COMMAND_ONLY_EFFECTS = ("servo",)
@@ -519,7 +595,17 @@ def validate_config(cfg: SimConfig) -> None:
     ):
         if not value > 0:
             raise ConfigError(f"config.effects.{name}: must be > 0, got {value}")
-    _check_ranges(cfg, ("servo", "bed_heterogeneity", "bed_packing", "hinge_friction"))
+    _check_ranges(
+        cfg,
+        (
+            "servo",
+            "bed_heterogeneity",
+            "bed_packing",
+            "hinge_friction",
+            "grain_contacts",
+            "bed_depth",
+        ),
+    )
 
 
 def _check_ranges(cfg: SimConfig, effects: tuple[str, ...]) -> None:

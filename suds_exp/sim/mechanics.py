@@ -14,7 +14,7 @@ import numpy as np
 
 from suds_exp.errors import ConfigError
 from suds_exp.sim import rft
-from suds_exp.sim.bed import draw_bed
+from suds_exp.sim.bed import draw_bed, draw_grains
 from suds_exp.sim.config import SimConfig
 
 #: Relative deviation of flipper_1..flipper_4's hinge friction from the mean, x spread.
@@ -42,6 +42,11 @@ class ElementTable:
     fl_hy: np.ndarray
     fl_side: np.ndarray
     l_ref: float
+
+    @property
+    def n_processes(self) -> int:
+        """Grain-contact processes of the kernel: one per element and one per part."""
+        return len(self.part) + rft.N_PARTS
 
     def kernel_args(self) -> tuple:
         return (
@@ -137,6 +142,10 @@ def pack_params(cfg: SimConfig) -> np.ndarray:
         p[rft.P_SGAIN] = 1000.0 / servo.compliance_rad_per_n_m / torque_unit
         p[rft.P_STALL] = stall
         p[rft.P_SDAMP] = stall / servo.no_load_speed_rad_s
+    gr = ef.grain_contacts
+    if gr.cv > 0:
+        p[rft.P_GSIG] = math.sqrt(math.log1p(gr.cv**2))
+        p[rft.P_GCOH] = gr.coherence
     fr = ef.hinge_friction
     for i, pattern in enumerate(HINGE_FRICTION_PATTERN):
         p[rft.P_HFRIC + i] = fr.torque_n_mm * (1.0 + fr.spread * pattern) / torque_unit
@@ -213,6 +222,15 @@ def simulate_prescribed(
     lengths = _lengths(phi, n_frames)
     p0, a0 = _initial_state(pose0, flippers0, n_trials)
     bed_modes, bed_scale = _beds(configs, trial_seeds)
+    grains = np.stack(
+        [
+            draw_grains(c, None if trial_seeds is None else trial_seeds[k], table.n_processes)
+            for k, c in enumerate(configs)
+        ]
+    )
+    if trial_seeds is None:
+        # a replay cannot know the grains a trial met: it sees the mean medium
+        prm[:, rft.P_GSIG] = 0.0
     out = {
         "pose": np.full((n_trials, n_max, 3), np.nan),
         "vel": np.full((n_trials, n_max, 3), np.nan),
@@ -232,6 +250,7 @@ def simulate_prescribed(
         float(dt),
         bed_modes,
         bed_scale,
+        grains,
         *(out[k] for k in ("pose", "vel", "flippers", "phi", "residual")),
         out["iterations"],
         out["continuations"],

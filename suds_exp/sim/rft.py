@@ -40,7 +40,12 @@ P_TOL, P_MAXIT, P_SFLOOR, P_LREF, P_SUBSTEPS = 16, 17, 18, 19, 20
 # (scaled), back-EMF damping (scaled torque s/rad); hinge friction torques of flippers 1-4
 P_SGAIN, P_STALL, P_SDAMP = 21, 22, 23
 P_HFRIC = 24
-N_PARAMS = 28
+# grain-scale contact fluctuations: log-sd of each element's drag multiplier and the
+# share of its log-variance common to its whole part (the slip correlation length is in
+# the modes' wavenumbers)
+P_GSIG, P_GCOH = 28, 29
+N_PARAMS = 30
+N_PARTS = 7
 # joint rate below which a servo loaded by the beans counts as stuck (rad/s)
 SERVO_STICK_RATE = 0.05
 # time constant (s) over which a servo's load follows the medium's torque
@@ -604,17 +609,32 @@ def _servo_rate(err, load, h, p):
 
 
 @njit(cache=True)
+def _field(modes, lo, hi, wx_, wy_):
+    """Sum of the random Fourier modes lo..hi-1 of the bed at world point (wx_, wy_) mm."""
+    g = 0.0
+    for m in range(lo, hi):
+        g += modes[m, 3] * math.cos(modes[m, 0] * wx_ + modes[m, 1] * wy_ + modes[m, 2])
+    return g
+
+
+@njit(cache=True)
 def _bed_weights(w_eff, geo, bed_k, scale, half_var, has_bed, X, Y, TH, lref, w_bed):
     """Each element's drag weight on the trial's bed, into ``w_bed`` (n_el,): ``w_eff``
-    times the packing ``scale`` and the random field (modes ``bed_k``, see bed.py) at the
-    element's world position (body pose X, Y mm, TH rad; ``geo`` in units of lref)."""
+    times the packing ``scale``, the immersion factor of the bed's depth field (second
+    half of the modes ``bed_k``, see bed.py) at the body origin (X, Y mm) and the local
+    resistance field (first half) at the element's world position (``geo`` in units of
+    lref, heading TH rad). ``half_var``: half the log variances (local, depth)."""
     n_el = w_eff.shape[0]
     if not has_bed:
         for e in range(n_el):
             w_bed[e] = w_eff[e]
         return
-    if half_var == 0.0:
-        # a uniform bed (packing only): no field to evaluate
+    nm = bed_k.shape[0] // 2
+    hv_local, hv_depth = half_var
+    if hv_depth > 0.0:
+        scale = scale * math.exp(_field(bed_k, nm, 2 * nm, X, Y) - hv_depth)
+    if hv_local == 0.0:
+        # no local field to evaluate
         for e in range(n_el):
             w_bed[e] = w_eff[e] * scale
         return
@@ -625,10 +645,56 @@ def _bed_weights(w_eff, geo, bed_k, scale, half_var, has_bed, X, Y, TH, lref, w_
             continue
         wx_ = X + lref * (cth * geo[e, 0] - sth * geo[e, 1])
         wy_ = Y + lref * (sth * geo[e, 0] + cth * geo[e, 1])
-        gsum = 0.0
-        for m in range(bed_k.shape[0]):
-            gsum += bed_k[m, 3] * math.cos(bed_k[m, 0] * wx_ + bed_k[m, 1] * wy_ + bed_k[m, 2])
-        w_bed[e] = w_eff[e] * scale * math.exp(gsum - half_var)
+        w_bed[e] = w_eff[e] * scale * math.exp(_field(bed_k, 0, nm, wx_, wy_) - hv_local)
+
+
+@njit(cache=True)
+def _grain_weights(w_bed, el_part, grain_k, slip, p):
+    """Multiply each element's drag weight by its grain-contact factor
+    exp(sig z - sig^2 / 2) (mean 1): z mixes its part's and its own unit Gaussian process
+    of slip distance, each a sum of random Fourier modes ``grain_k`` (n_el + N_PARTS,
+    n_modes, 2: wavenumber per scaled length, phase) at the process's slip ``slip``."""
+    sig = p[P_GSIG]
+    coh = p[P_GCOH]
+    a = math.sqrt(coh)
+    b = math.sqrt(1.0 - coh)
+    n_el = el_part.shape[0]
+    amp = math.sqrt(2.0 / grain_k.shape[1])
+    for e in range(n_el):
+        q = n_el + el_part[e]
+        ze = 0.0
+        zq = 0.0
+        for m in range(grain_k.shape[1]):
+            ze += math.cos(grain_k[e, m, 0] * slip[e] + grain_k[e, m, 1])
+            zq += math.cos(grain_k[q, m, 0] * slip[q] + grain_k[q, m, 1])
+        z = amp * (a * zq + b * ze)
+        w_bed[e] *= math.exp(sig * z - 0.5 * sig * sig)
+
+
+@njit(cache=True)
+def _grain_slip(x, geo, el_part, w_bed, sh, slip):
+    """Add each element's slip through the medium over the step to ``slip`` (scaled
+    lengths; sh = shape rate x step, so the slip is the scaled speed times sh and does not
+    depend on how fast the shape changes); a part slips by its elements' mean."""
+    n_el = el_part.shape[0]
+    part_slip = np.zeros(N_PARTS)
+    part_n = np.zeros(N_PARTS)
+    for e in range(n_el):
+        if w_bed[e] == 0.0:
+            continue
+        h = int(geo[e, 8])
+        uh = 0.0
+        if h >= 0:
+            uh = x[3 + h]
+        vx = x[0] - x[2] * geo[e, 1] + geo[e, 4] * uh + geo[e, 6]
+        vy = x[1] + x[2] * geo[e, 0] + geo[e, 5] * uh + geo[e, 7]
+        ds = math.sqrt(vx * vx + vy * vy) * sh
+        slip[e] += ds
+        part_slip[el_part[e]] += ds
+        part_n[el_part[e]] += 1.0
+    for q in range(N_PARTS):
+        if part_n[q] > 0.0:
+            slip[n_el + q] += part_slip[q] / part_n[q]
 
 
 @njit(cache=True)
@@ -703,11 +769,15 @@ def _flipper_midpoints(ang, uprev, held, h, amax, mode, amid):
 
 @njit(cache=True)
 def _bed_half_var(bed_k):
-    """Half the variance of the bed field's log (bed.py) from its modes ``bed_k``."""
-    half_var = 0.0
-    for m in range(bed_k.shape[0]):
-        half_var += 0.25 * bed_k[m, 3] * bed_k[m, 3]
-    return half_var
+    """Half the variances of the bed fields' logs (bed.py) from their modes ``bed_k``:
+    (local resistance field, depth field)."""
+    nm = bed_k.shape[0] // 2
+    local = 0.0
+    depth = 0.0
+    for m in range(nm):
+        local += 0.25 * bed_k[m, 3] * bed_k[m, 3]
+        depth += 0.25 * bed_k[nm + m, 3] * bed_k[nm + m, 3]
+    return local, depth
 
 
 @njit(cache=True)
@@ -768,7 +838,7 @@ def _record_frame(k, i, X, Y, TH, ang, rmax, j1, j2, pose, ang_out, resid, phi_o
 
 
 @njit(cache=True)
-def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k):
+def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k, grain_k):
     """One substep of trial interval f, from fraction ``fa`` to ``fb`` of it: the joints
     move (`_joint_substep`), the balance of forces is solved at the midpoint, the twist
     relaxes and the pose moves, free flippers advance.
@@ -781,17 +851,20 @@ def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k):
     """
     r1, r2, load1, load2, v0, v1, v2, X, Y, TH, dist = state
     h, lp, relax, half_var, bed_scale = trial
-    geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed = buf
+    geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed, slip = buf
     lref, amax, mode = p[P_LREF], p[P_AMAX], int(p[P_FLMODE])
     servo = p[P_SGAIN] > 0.0
+    grains = p[P_GSIG] > 0.0
     a1, a2, b1, b2, r1, r2 = _joint_substep(phi_k, f, fa, fb, servo, r1, r2, load1, load2, h, p)
     d1 = (b1 - a1) / h
     d2 = (b2 - a2) / h
     s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
     _flipper_midpoints(ang, uprev, held, h, amax, mode, amid)
     _element_geometry(0.5 * (a1 + b1), 0.5 * (a2 + b2), d1 / s, d2 / s, amid, body, geo)
-    has_bed = half_var > 0.0 or bed_scale != 1.0
+    has_bed = half_var[0] > 0.0 or half_var[1] > 0.0 or bed_scale != 1.0
     _bed_weights(w_eff, geo, bed_k, bed_scale, half_var, has_bed, X, Y, TH, lref, w_bed)
+    if grains:
+        _grain_weights(w_bed, body[0], grain_k, slip, p)
     _predict_twist(x, xlast)
     normal_fac = p[P_NORMAL] * (1.0 + p[P_COMPACT] * dist)
     nr, it, cont = _solve_with_stops(
@@ -803,6 +876,8 @@ def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k):
     load1 += lp * (abs(work[4, 4]) - load1)
     load2 += lp * (abs(work[4, 5]) - load2)
     v0, v1, v2, X, Y, TH, dist = _relax_and_move(x, s, lref, relax, h, v0, v1, v2, X, Y, TH, dist)
+    if grains:
+        _grain_slip(x, geo, body[0], w_bed, s * h, slip)
     if mode == FL_FREE:
         _advance_flippers(x, s, h, amax, held, ang, uprev)
     return (r1, r2, load1, load2, v0, v1, v2, X, Y, TH, dist), nr, it, cont
@@ -826,6 +901,7 @@ def run_trials(
     dt,
     bed,
     bed_scale,
+    grains,
     pose,
     vel,
     ang_out,
@@ -840,7 +916,9 @@ def run_trials(
     trial k: the joint angles, or the servo command when prm[k, P_SGAIN] > 0. pose0
     (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, N_PARAMS); bed
     (n_trials, n_modes, 4) random Fourier modes of the bed (kx, ky in 1/mm, phase,
-    amplitude; see bed.py) and bed_scale (n_trials,) its trial factor. Outputs (filled):
+    amplitude; see bed.py) and bed_scale (n_trials,) its trial factor; grains (n_trials,
+    n_el + N_PARTS, n_modes, 2) the grain contacts' random modes in slip distance (see
+    bed.py; used when prm[k, P_GSIG] > 0). Outputs (filled):
     phi_out (n_trials, n_frames, 2) realised joint angles (rad); pose (n_trials,
     n_frames, 3) world x, y (mm), theta;
     vel (n_trials, n_frames, 3) body twist vx, vy (mm/s), wz (rad/s), centred on the
@@ -853,7 +931,8 @@ def run_trials(
     x, xlast = np.zeros(N_UNKNOWN), np.zeros(N_UNKNOWN)
     held, ang, amid, uprev = np.zeros(4, dtype=np.bool_), np.zeros(4), np.zeros(4), np.zeros(4)
     w_eff, w_bed = np.empty(n_el), np.empty(n_el)
-    buf = (geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed)
+    slip = np.zeros(n_el + N_PARTS)
+    buf = (geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed, slip)
     for k in range(phi.shape[0]):
         p = prm[k]
         nsub = int(p[P_SUBSTEPS])
@@ -861,6 +940,7 @@ def run_trials(
         relax = 1.0 if p[P_TAU] <= 0.0 else 1.0 - math.exp(-h / p[P_TAU])
         trial = (h, 1.0 - math.exp(-h / SERVO_LOAD_TAU), relax, _bed_half_var(bed[k]), bed_scale[k])
         _start_trial(p, el_w, el_part, ang0[k], w_eff, ang, held, uprev, x, xlast)
+        slip[:] = 0.0
         servo = p[P_SGAIN] > 0.0
         r1, r2 = phi[k, 0, 0], phi[k, 0, 1]
         X, Y, TH = pose0[k, 0], pose0[k, 1], pose0[k, 2]
@@ -875,8 +955,9 @@ def run_trials(
             rmax = 0.0
             for sub in range(nsub):
                 state, nr, it, cont = _substep(
-                    phi[k], f, sub / nsub, (sub + 1) / nsub, p, state, trial, body, buf, bed[k]
-                )
+                    phi[k], f, sub / nsub, (sub + 1) / nsub, p, state, trial, body, buf, bed[k],
+                    grains[k],
+                )  # fmt: skip
                 iters[k] += it
                 if cont:
                     n_cont[k] += 1
