@@ -1,34 +1,32 @@
 """Calibration of the simulator's variability effects against the paper's findings.
 
-For each setting (a few effect parameters over the nominal robot, always inside their
-realistic ranges) it simulates a dataset, ingests and preprocesses it, runs a reduced
-campaign (same learners, default parameters: the learners are never tuned here) and
-prints the statistics of the paper's findings that a reduced campaign can show:
+For each setting (effect parameters over the nominal robot, always inside their realistic
+ranges) it simulates the default design (5 gaits x 3 frequencies x 4 repeats, dataset
+``--seed``), ingests and preprocesses it, runs a reduced campaign (the five learners at
+their defaults - the learners are never tuned here -, every pair of conditions with
+``--boots`` draws at 30 training cycles, and the sweep ``--sweep`` on same-condition
+pairs) and measures the paper's findings F1-F10 with `suds_exp.analysis.findings`
+(the statistics of the README's "The paper's findings"; ``--n-boot`` replicates). It also
+prints, as the diagnosis of issue 17, how much of r_a, rp_1 and vx the gait phase leaves
+unexplained (RMS deviation from the phase-bin mean / SD, median over conditions).
 
-- F1 phase-only is the worst learner: median RMS error of vx on same-condition pairs at
-  30 training cycles, per frequency; holds if phase-only's median is the largest at every
-  frequency;
-- F2 TLS improves on phase-only about 3x: phase-only / TLS medians; holds if >= 1.5 at
-  every frequency;
-- F3 TLS+SUDS beats TLS: TLS / TLS+SUDS medians; holds if > 1 at every frequency;
-- F4 GMR beats TLS: GMR / TLS medians; holds if < 1 at every frequency;
-- F7 error grows with frequency: holds if every learner's median at 1 Hz exceeds its
-  median at 1/3 Hz (same-condition pairs);
-- F9 GLM signs (interactions model, 100 ln RMS error, every pair): SUDS < 0, GMR < 0,
-  SUDS:GMR > 0;
+Settings:
 
-and, as the diagnosis of issue 17, how much of each signal the gait phase explains: per
-condition the RMS deviation of r_a, rp_1 and vx from their phase mean (32 phase bins over
-the condition's trials) as a fraction of their standard deviation (median over
-conditions).
+- ``--settings nominal,old``: named ones (`NAMED`);
+- ``--search N --rng R``: N settings drawn uniformly from `SEARCH_SPACE` (a few
+  variability parameters, each inside its realistic range), reproducible from R;
+- ``--ablation``: the chosen setting ``--set ...`` (default ``calibrated``,
+  `examples/calibrated_robot.toml`) with each of its effects switched off in turn: which
+  effect each finding needs;
+- ``--set EFFECT.PARAM=VALUE ...``: one setting.
 
-    .venv/bin/python benchmarks/calibrate.py --settings old,variability --out calib.csv
-    .venv/bin/python benchmarks/calibrate.py --settings search        # the grid
-    .venv/bin/python benchmarks/calibrate.py --settings ablation      # variability minus one
-    .venv/bin/python benchmarks/calibrate.py --set servo.compliance_rad_per_n_m=0.2 ...
+A reduced campaign takes 1.5-4 min on 2 cores (``--jobs``). Rows are appended to ``--out``
+as settings finish (an interrupted run keeps them; a re-run skips them), and a summary
+(findings holding, on the paper's side, values) is printed for the settings asked for.
 
-A setting is a list of ``EFFECT.PARAM=VALUE`` over the nominal configuration. Rows are
-appended to --out as settings finish (an interrupted run keeps them; a re-run skips them).
+    .venv/bin/python benchmarks/calibrate.py --settings nominal,old --out calib.csv
+    .venv/bin/python benchmarks/calibrate.py --search 20 --rng 1 --out calib.csv
+    .venv/bin/python benchmarks/calibrate.py --ablation --out calib.csv
 """
 
 from __future__ import annotations
@@ -45,59 +43,92 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from suds_exp.analysis.glm import glm_table  # noqa: E402
-from suds_exp.analysis.queries import load_results  # noqa: E402
+from suds_exp.analysis.findings import findings  # noqa: E402
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.ingest import ingest_paths  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
-from suds_exp.sim import SimConfig, apply_effects, simulate_dataset  # noqa: E402
+from suds_exp.sim import SimConfig, apply_effects, effect_library, simulate_dataset  # noqa: E402
+from suds_exp.sim.config import load_config  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
-#: The variability effects of issue 17 at the values tried first (off in the nominal
-#: robot: they did not make the findings hold, see the README).
-VARIABILITY = [
-    "servo.compliance_rad_per_n_m=0.05",
-    "bed_heterogeneity.spatial_cv=0.2",
-    "bed_packing.trial_cv=0.15",
-    "hinge_friction.torque_n_mm=10",
-]
-ABLATION = {
-    "old": [],
-    "variability": VARIABILITY,
-    **{
-        f"variability_without_{item.split('.')[0]}": [i for i in VARIABILITY if i != item]
-        for item in VARIABILITY
-    },
+#: Effects and their settings that describe a robot's variability (issue 17).
+VARIABILITY_EFFECTS = (
+    "servo",
+    "bed_depth",
+    "bed_heterogeneity",
+    "bed_packing",
+    "grain_contacts",
+    "hinge_friction",
+)
+#: The parameters the search draws, with the part of each realistic range searched
+#: (the 1 Hz gait needs 6.3 rad/s, so slower servos are not searched).
+SEARCH_SPACE = {
+    "servo.compliance_rad_per_n_m": (0.12, 0.4),
+    "servo.stall_torque_n_m": (2.0, 6.0),
+    "servo.no_load_speed_rad_s": (10.0, 12.0),
+    "bed_depth.cv": (0.2, 0.5),
+    "bed_depth.correlation_mm": (50.0, 300.0),
+    "grain_contacts.cv": (0.0, 0.3),
+    "bed_packing.trial_cv": (0.0, 0.3),
+    "hinge_friction.torque_n_mm": (0.0, 30.0),
 }
+#: Settings by name: the robot before issue 17's variability, and the nominal one.
+CALIBRATED = Path(__file__).resolve().parents[1] / "examples" / "calibrated_robot.toml"
+NAMED = {
+    "old": [f"{e}=off" for e in VARIABILITY_EFFECTS],
+    "nominal": [],
+    # the settings of examples/calibrated_robot.toml
+    "calibrated": [
+        "servo.compliance_rad_per_n_m=0.2",
+        "servo.stall_torque_n_m=6",
+        "servo.no_load_speed_rad_s=12",
+        "bed_depth.cv=0.3",
+        "bed_depth.correlation_mm=150",
+        "bed_packing.trial_cv=0.2",
+    ],
+}
+FINDINGS = ("F1", "F2", "F3", "F4", "F5", "F6", "F7", "F8a", "F8b", "F9a", "F9b", "F9c", "F10")
 
 
-def search_grid() -> dict[str, list[str]]:
-    """Servo compliance x bed variability (spatial and per-trial, together)."""
-    grid = {}
-    for comp in (0.05, 0.15, 0.3):
-        for cv in (0.1, 0.25):
-            grid[f"servo{comp}_bed{cv}"] = [
-                f"servo.compliance_rad_per_n_m={comp}",
-                f"bed_heterogeneity.spatial_cv={cv}",
-                f"bed_packing.trial_cv={cv}",
-            ]
-    return grid
+def check_space() -> None:
+    """Refuse a search space reaching outside a parameter's realistic range, and a
+    "calibrated" setting that is not the example file's."""
+    if load_config(CALIBRATED) != apply_effects(SimConfig(), NAMED["calibrated"]):
+        raise SystemExit(f"NAMED['calibrated'] differs from {CALIBRATED}")
+    ranges = {
+        p["config_key"].removeprefix("effects."): p["range"]
+        for e in effect_library()
+        for p in e["parameters"]
+    }
+    for key, (lo, hi) in SEARCH_SPACE.items():
+        low, high = ranges[key]
+        if not low <= lo <= hi <= high:
+            raise SystemExit(f"SEARCH_SPACE[{key!r}] = {lo}..{hi} leaves its range {low}..{high}")
 
 
-def build(items: list[str]) -> SimConfig:
-    return apply_effects(SimConfig(), items, param="--set")
+def draw(rng: np.random.Generator) -> list[str]:
+    return [f"{k}={rng.uniform(lo, hi):.3g}" for k, (lo, hi) in SEARCH_SPACE.items()]
+
+
+def ablation(items: list[str]) -> dict[str, list[str]]:
+    """``items`` and, per variability effect on in that setting, the same with that
+    effect switched off."""
+    state = {e["name"]: e["state"] for e in effect_library(apply_effects(SimConfig(), items))}
+    plan = {"all": items}
+    for e in VARIABILITY_EFFECTS:
+        if state[e] == "on":
+            plan[f"without_{e}"] = items + [f"{e}=off"]
+    return plan
 
 
 def phase_explained(store: Store, prep: str) -> dict[str, float]:
     """Median over conditions of RMS(signal - its phase-bin mean) / SD(signal)."""
-    with store.read() as conn:
-        s = Store.frame(
-            conn,
-            "SELECT t.gait, t.frequency_hz, s.phase, s.ra_1, s.ra_2, s.rp_1, s.vx "
-            "FROM samples s JOIN trials t ON t.id = s.trial_id "
-            "JOIN prep_versions v ON v.id = s.version_id WHERE v.name = ?",
-            [prep],
-        )
+    s = store.query_df(
+        "SELECT t.gait, t.frequency_hz, s.phase, s.ra_1, s.ra_2, s.rp_1, s.vx "
+        "FROM samples s JOIN trials t ON t.id = s.trial_id "
+        "JOIN prep_versions v ON v.id = s.version_id WHERE v.name = ?",
+        [prep],
+    )
     s["bin"] = np.floor((s["phase"] % (2 * np.pi)) / (2 * np.pi) * 32).astype(int)
     out: dict[str, list[float]] = {"ra": [], "rp_1": [], "vx": []}
     for _, g in s.groupby(["gait", "frequency_hz"]):
@@ -109,101 +140,88 @@ def phase_explained(store: Store, prep: str) -> dict[str, float]:
     return {f"phase_resid_{k}": float(np.median(v)) for k, v in out.items()}
 
 
-def findings(store: Store, campaign: str) -> dict:
-    """The statistics of F1-F4, F7, F9 (see the module docstring)."""
-    res = load_results(store, campaign, columns=None)
-    same = res[
-        (res.train_gait == res.test_gait) & (res.train_frequency_hz == res.test_frequency_hz)
-    ]
-    med = same.groupby(["model", "test_frequency_hz"])["rmse_vx"].median().unstack()
-    freqs = sorted(med.columns)
-    row: dict = {}
-    for f in freqs:
-        tag = f"{f:.2f}"
-        for m in med.index:
-            row[f"med_{m}_{tag}"] = float(med.loc[m, f])
-        row[f"phase/TLS_{tag}"] = med.loc["phase-only", f] / med.loc["TLS", f]
-        row[f"TLS/TLS+SUDS_{tag}"] = med.loc["TLS", f] / med.loc["TLS+SUDS", f]
-        row[f"GMR/TLS_{tag}"] = med.loc["GMR", f] / med.loc["TLS", f]
-    row["F1"] = all(med[f].idxmax() == "phase-only" for f in freqs)
-    row["F2"] = all(row[f"phase/TLS_{f:.2f}"] >= 1.5 for f in freqs)
-    row["F3"] = all(row[f"TLS/TLS+SUDS_{f:.2f}"] > 1 for f in freqs)
-    row["F4"] = all(row[f"GMR/TLS_{f:.2f}"] < 1 for f in freqs)
-    row["F7"] = bool((med[freqs[-1]] > med[freqs[0]]).all())
-    glm = glm_table(res)
-    inter = glm[glm.model == "interactions"].set_index("term")["coef"]
-    row["glm_SUDS"] = float(inter.get("SUDS", np.nan))
-    row["glm_GMR"] = float(inter.get("GMR", np.nan))
-    row["glm_SUDS:GMR"] = float(inter.get("SUDS:GMR", np.nan))
-    row["F9"] = row["glm_SUDS"] < 0 and row["glm_GMR"] < 0 and row["glm_SUDS:GMR"] > 0
-    return row
-
-
 def run_setting(name: str, items: list[str], args) -> dict:
-    cfg = build(items)
+    cfg = apply_effects(SimConfig(), items, param="--set")
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="suds-calibrate-") as tmp:
-        ds = simulate_dataset(
-            Path(tmp) / "data",
-            cfg,
-            gaits=args.gaits.split(","),
-            repeats=args.repeats,
-            seed=args.seed,
-        )
+        ds = simulate_dataset(Path(tmp) / "data", cfg, seed=args.seed)
         store = Store(Path(tmp) / "calib.duckdb")
         ingest_paths(store, [Path(tmp) / "data"], ds.manifest, None, progress=False)
-        preprocess(store, "v1", progress=False)
-        opts = CampaignOptions(prep="v1", boots=args.boots, train_cycles=30)
+        prep = preprocess(store, progress=False).name
+        opts = CampaignOptions(
+            prep=prep,
+            boots=args.boots,
+            train_cycles=30,
+            sweep=[int(c) for c in args.sweep.split(",")],
+            skip_infeasible=True,
+        )
         run_campaign(store, "calib", opts, jobs=args.jobs, progress=False)
         row = {"setting": name, "items": json.dumps(items), "seed": args.seed}
-        row.update(phase_explained(store, "v1"))
-        row.update(findings(store, "calib"))
+        row.update(phase_explained(store, prep))
+        table = findings(store, "calib", n_boot=args.n_boot)
+    for r in table.itertuples():
+        row[f"value_{r.id}"] = r.value
+        row[f"verdict_{r.id}"] = r.verdict
     row["seconds"] = time.perf_counter() - started
     return row
 
 
 def summary(table: pd.DataFrame) -> str:
-    cols = ["setting", "seed", "phase_resid_ra", "phase_resid_rp_1", "phase_resid_vx"]
-    cols += [c for c in table.columns if c.startswith(("phase/TLS", "TLS/TLS+SUDS", "GMR/TLS"))]
-    cols += ["glm_SUDS", "glm_GMR", "glm_SUDS:GMR", "F1", "F2", "F3", "F4", "F7", "F9"]
-    return table[[c for c in cols if c in table.columns]].to_string(
-        index=False, float_format=lambda v: f"{v:.3g}"
+    verdicts = table[[f"verdict_{f}" for f in FINDINGS]]
+    out = pd.DataFrame(
+        {
+            "setting": table.setting,
+            "seed": table.seed,
+            "hold": (verdicts == "holds").sum(axis=1),
+            "side": verdicts.isin(["holds", "unclear"]).sum(axis=1),
+            "ra/rp1/vx left": [
+                f"{a:.2f}/{b:.2f}/{c:.2f}"
+                for a, b, c in zip(
+                    table.phase_resid_ra, table.phase_resid_rp_1, table.phase_resid_vx, strict=True
+                )
+            ],
+        }
     )
+    for f in FINDINGS:
+        out[f] = table[f"value_{f}"].map(lambda v: f"{v:.2f}")
+    return out.sort_values(["side", "hold"], ascending=False).to_string(index=False)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--settings", default="old,variability", help="names, ablation or search")
-    ap.add_argument("--set", nargs="*", default=None, help="one ad-hoc setting (EFFECT.PARAM=V)")
-    ap.add_argument("--gaits", default="S+,O,D-", help="gaits of the reduced design")
-    ap.add_argument("--repeats", type=int, default=4)
-    ap.add_argument("--boots", type=int, default=3)
+    ap.add_argument("--settings", default="", help="named settings: " + ", ".join(NAMED))
+    ap.add_argument("--search", type=int, default=0, help="draw this many settings")
+    ap.add_argument("--rng", type=int, default=0, help="seed of the search's draws")
+    ap.add_argument("--ablation", action="store_true", help="switch each effect off in turn")
+    ap.add_argument("--set", nargs="*", default=None, help="one setting (EFFECT.PARAM=V)")
     ap.add_argument("--seed", type=int, default=0, help="dataset seed")
+    ap.add_argument("--boots", type=int, default=2)
+    ap.add_argument("--sweep", default="2,5,10,30")
+    ap.add_argument("--n-boot", type=int, default=100, help="bootstrap replicates")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("bench-calibrate.csv"))
     args = ap.parse_args()
+    check_space()
     plan: dict[str, list[str]] = {}
-    if args.set is not None:
-        plan["custom:" + ",".join(args.set)] = list(args.set)
     for name in [n for n in args.settings.split(",") if n]:
-        if name == "search":
-            plan.update(search_grid())
-        elif name == "ablation":
-            plan.update(ABLATION)
-        elif name in ABLATION:
-            plan[name] = ABLATION[name]
-        else:
-            raise SystemExit(
-                f"--settings: unknown {name!r}; expected search, ablation, "
-                f"or one of {', '.join(ABLATION)}"
-            )
+        if name not in NAMED:
+            raise SystemExit(f"--settings: unknown {name!r}; expected {', '.join(NAMED)}")
+        plan[name] = NAMED[name]
+    if args.ablation:
+        base = args.set if args.set is not None else NAMED["calibrated"]
+        plan.update(ablation(base))
+    elif args.set is not None:
+        plan["custom:" + ",".join(args.set)] = list(args.set)
+    rng = np.random.default_rng(args.rng)
+    for i in range(args.search):
+        plan[f"search{args.rng}-{i}"] = draw(rng)
     done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
     have = set(zip(done.get("setting", []), done.get("seed", []), strict=False))
     for name, items in plan.items():
         if (name, args.seed) in have:
             continue
         row = run_setting(name, items, args)
-        print(json.dumps(row, default=str), flush=True)
+        print(json.dumps({k: row[k] for k in ("setting", "items", "seconds")}), flush=True)
         pd.DataFrame([row]).to_csv(args.out, mode="a", header=not args.out.exists(), index=False)
     table = pd.read_csv(args.out)
     print(summary(table[table.setting.isin(plan) & (table.seed == args.seed)]))

@@ -146,9 +146,10 @@ def test_phase_only_is_tls_constant_term_at_the_same_phase_resolution():
          "ra_1": ra[:, 0], "ra_2": ra[:, 1], "dra_1": dra[:, 0], "dra_2": dra[:, 1],
          "vx": vx, "vy": 0.1 * vx, "wz": 0.0}
     )  # fmt: skip
-    assert make_model("phase-only").get_params()["order"] == make_model("TLS").get_params()[
-        "gait_order"
-    ]
+    assert (
+        make_model("phase-only").get_params()["order"]
+        == make_model("TLS").get_params()["gait_order"]
+    )
     phase_only = make_model("phase-only").fit(frame).predict(frame)["vx"]
     tls = make_model("TLS").fit(frame).predict(frame)["vx"]
     np.testing.assert_allclose(tls, phase_only, atol=1e-6 * np.abs(vx).max())
