@@ -133,6 +133,8 @@ def withheld_run(effect: str, seed: int) -> dict:
         "gap_closed_by_term": d.improvement if d is not None else 0.0,
         "p_term": d.p_value if d is not None else None,
         "physics": d.physics if d is not None else "",
+        "physics_body": d.physics_by_part["body"] if d is not None else "",
+        "physics_passive": d.physics_by_part["passive"] if d is not None else "",
         "expected": EXPECTED_PHYSICS.get(effect, ""),
         "leading": ";".join(d.leading[:3]) if d is not None else "",
         "equations": " | ".join(d.equations()) if d is not None else "",
@@ -150,9 +152,12 @@ def withheld_summary(table: pd.DataFrame) -> pd.DataFrame:
     """Per withheld effect: seeds, wrong-name rate (a candidate named as the cause), rate
     and share closed of candidates reported as partial explanations, unexplained rate,
     gap closed by the discovered term (median, of the gap it was given; 0 when none was
-    added), total gap closed, physics-match rate, leading features."""
+    added), total gap closed, physics-match rates (over all channels, the body velocity's
+    and the passive shape's terms; NaN for a table written before the last two were
+    recorded), leading features."""
     rows = []
     for effect, g in table.groupby("withheld"):
+        expected = g["expected"].notna().all() and g["expected"].astype(str).ne("").all()
         closed = np.where(g["discovered"], g["gap_closed_by_term"], 0.0)
         lead = g["leading"].fillna("").str.split(";").str[0]
         part = g["partial"].astype("string").fillna("")
@@ -171,9 +176,12 @@ def withheld_summary(table: pd.DataFrame) -> pd.DataFrame:
                 "added_rate": g["discovered"].mean(),
                 "median_gap_closed": float(np.median(closed)),
                 "closed_ge_50pct": float(np.mean(closed >= 0.5)),
-                "physics_match": float((g["physics"] == g["expected"]).mean())
-                if g["expected"].notna().all() and g["expected"].astype(str).ne("").all()
-                else np.nan,
+                **{
+                    f"{col}_match": float((g[col] == g["expected"]).mean())
+                    if expected and col in g
+                    else np.nan
+                    for col in ("physics", "physics_body", "physics_passive")
+                },
                 "leading_features": ", ".join(
                     f"{k} ({v})" for k, v in lead[lead != ""].value_counts().items()
                 ),

@@ -33,6 +33,7 @@ from sklearn.model_selection import GroupKFold
 
 from suds_exp.discrepancy.features import IN_CHANNEL_UNIT, PHYSICS, Feature, channel_unit
 from suds_exp.discrepancy.fit_candidates import held_out_p, trial_losses
+from suds_exp.discrepancy.replay import CHANNELS as BODY_CHANNELS
 from suds_exp.errors import DiscrepancyError
 
 
@@ -126,9 +127,23 @@ class Discovery:
         (`features.PHYSICS`) whose terms carry the largest total share over all channels.
         By share, not by the single largest term: one effect shows in several channels
         (an inertia lags vx, vy and wz alike) and is not outvoted by one large term."""
+        return self.physics_of(self.channels)
+
+    @property
+    def physics_by_part(self) -> dict[str, str]:
+        """The same reading for the body velocity (vx, vy, wz) and for the passive shape
+        (r_p) apart: an effect acts on one and shows in the other through the body's
+        mechanics, so the two may read differently (asymmetric drag is a sign-dependent
+        force on the body and reshapes the flippers' stroke), '' for a part with no term."""
+        body = tuple(c for c in self.channels if c in BODY_CHANNELS)
+        passive = tuple(c for c in self.channels if c not in BODY_CHANNELS)
+        return {"body": self.physics_of(body), "passive": self.physics_of(passive)}
+
+    def physics_of(self, channels) -> str:
+        """The physics whose terms carry the largest total share over ``channels``."""
         share: dict[str, float] = {}
         for t in self.terms:
-            if t.feature.family != "constant":
+            if t.feature.family != "constant" and t.channel in channels:
                 name = PHYSICS.get(t.feature.family, t.feature.family)
                 share[name] = share.get(name, 0.0) + t.weight
         return max(share, key=share.get) if share else ""

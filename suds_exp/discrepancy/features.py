@@ -117,7 +117,7 @@ def _rate(x: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 
 def feature_library(
-    windows: WindowSet, samples: pd.DataFrame, sim: np.ndarray
+    windows: WindowSet, samples: pd.DataFrame, sim: np.ndarray, half_middle_mm: float
 ) -> tuple[np.ndarray, list[Feature]]:
     """Every feature at every scored sample.
 
@@ -129,6 +129,9 @@ def feature_library(
         The samples the windows were cut from (`suds_exp.preprocess.load_samples`).
     sim : array of shape (n_windows, n_samples, n_channels)
         The model's replay of those windows (channels as `replay`).
+    half_middle_mm : float
+        Half the middle segment's length, mm (the motor axes' offset from the body
+        origin), for each segment's sliding velocity (`segment_sliding`).
 
     Returns
     -------
@@ -173,8 +176,13 @@ def feature_library(
         # measured: the inertia's own form, v = v_model - tau dv/dt (equation error)
         cols.append((Feature(name, unit, "acceleration"), acc_meas[..., i]))
         cols.append((Feature(f"{name}^model", unit, "acceleration"), acc[..., i]))
-    # sliding forward and backward may meet different drag: the forward part of v_x
-    cols.append((Feature("max(v_x,0)", "mm/s", "sign"), np.maximum(v[..., 0], 0.0)))
+    # sliding forward and backward may meet different drag: the forward part of each
+    # segment's sliding velocity (the middle one's is v_x); the head and tail often
+    # slide against the body, so the body's v_x alone misses most of an asymmetry
+    u = segment_sliding(v, ra, half_middle_mm)
+    cols.append((Feature("max(v_x,0)", "mm/s", "sign"), np.maximum(u[..., 0], 0.0)))
+    for i, seg in ((1, "head"), (2, "tail")):
+        cols.append((Feature(f"max(u_{seg},0)", "mm/s", "sign"), np.maximum(u[..., i], 0.0)))
     cols.append((Feature("|w_z|", "rad/s", "sign"), np.abs(v[..., 2])))
     for i in range(2):
         cols.append((Feature(f"phi{i + 1}", "rad", "shape"), ra[..., i]))
@@ -202,34 +210,67 @@ def feature_library(
     return X, features
 
 
+#: Time constants (s) of the lagged copies of each channel (`channel_features`): a
+#: logarithmic grid over the lags the library's effects span (body inertia 0-0.5 s; a
+#: viscous flipper hinge over the medium's resistance, tenths of a second).
+LAG_TAUS_S = (0.05, 0.15, 0.45)
+
+
+def _lagged(x: np.ndarray, t: np.ndarray, tau: float) -> np.ndarray:
+    """First-order lag of x along axis 1 with time constant ``tau`` (s): tau dy/dt = x - y,
+    starting at rest on each window's first sample (so a window's first ~tau seconds
+    carry a start-up transient). Windows are NaN padded at their ends, which the
+    recursion leaves NaN."""
+    dt = np.nanmedian(np.diff(t, axis=1), axis=1)
+    dt = np.where(np.isfinite(dt) & (dt > 0), dt, 1.0)
+    a = np.exp(-dt / tau).reshape((-1,) + (1,) * (x.ndim - 2))
+    y = np.empty_like(x)
+    y[:, 0] = x[:, 0]
+    for k in range(1, x.shape[1]):
+        y[:, k] = a * y[:, k - 1] + (1 - a) * x[:, k]
+    return y
+
+
 def channel_features(windows: WindowSet, sim: np.ndarray) -> tuple[np.ndarray, list[Feature]]:
-    """Features that differ per channel: the first-order lag of the channel itself.
+    """Features that differ per channel: the lag of the channel itself.
 
     A channel that lags its quasi-static value with time constant tau reads
-    ``x = x_model - tau dx_model/dt`` to first order. For the body velocity that lag is
-    momentum (inertia); for the passive shape it is the flippers lagging their
-    quasi-static opening, which is what a viscous hinge does (damping). So the model's own
-    rate of each channel is one feature per physics, zero on the channels it does not
-    apply to.
+    ``x = x_model - tau dx_model/dt`` to first order, and ``x = lag_tau(x_model)`` (the
+    first-order low-pass, tau dx/dt = x_model - x) in full. For the body velocity that
+    lag is momentum (inertia: the simulator's own form of it); for the passive shape it
+    is the flippers lagging their quasi-static opening, which is what a viscous hinge
+    does (damping). A lag too large for the first-order form (a stiff hinge damper
+    nearly stops the flippers) is still one term, ``lag_tau(x_model) - x_model``, at the
+    nearest of `LAG_TAUS_S` (coefficient 1: that lag in full). So the model's own rate
+    and its lagged copies of each channel are features per physics, zero on the
+    channels they do not apply to.
 
     Returns
     -------
-    Xc : array (n_windows, n_samples, n_channels, 2)
-    features : the two `Feature` s (coefficients in s)
+    Xc : array (n_windows, n_samples, n_channels, 2 + 2 len(LAG_TAUS_S))
+    features : the `Feature` s (the rates' coefficients in s, the lags' in 1)
     """
     t = window_field(windows, "t")
     rate = _rate(sim, t)
     n_ch = sim.shape[-1]
     body = np.arange(n_ch) < 3
-    Xc = np.zeros(sim.shape + (2,))
+    n_lag = len(LAG_TAUS_S)
+    Xc = np.zeros(sim.shape + (2 + 2 * n_lag,))
     Xc[..., body, 0] = rate[..., body]
     Xc[..., ~body, 1] = rate[..., ~body]
+    for j, tau in enumerate(LAG_TAUS_S):
+        lag = _lagged(sim, t, tau) - sim
+        Xc[..., body, 2 + j] = lag[..., body]
+        Xc[..., ~body, 2 + n_lag + j] = lag[..., ~body]
     Xc[~np.isfinite(t)] = np.nan
     unit = f"{IN_CHANNEL_UNIT}/s"
     return Xc, [
         Feature("d/dt(own velocity)^model", unit, "acceleration"),
         Feature("d/dt(own r_p)^model", unit, "rate"),
-    ]
+    ] + [
+        Feature(f"lag_{tau:g}s(own velocity)^model", IN_CHANNEL_UNIT, "acceleration")
+        for tau in LAG_TAUS_S
+    ] + [Feature(f"lag_{tau:g}s(own r_p)^model", IN_CHANNEL_UNIT, "rate") for tau in LAG_TAUS_S]
 
 
 def effect_features(

@@ -83,12 +83,14 @@ def discover_step(
     train_ids,
     opts,
     rng: np.random.Generator,
+    half_middle_mm: float,
     partial: list[tuple[np.ndarray, list]] = (),
 ) -> Discovery:
     """The learned correction of the current replay ``sim`` (no new replay): the shared
     `feature_library`, each channel's own lag (`channel_features`) and, for every effect
-    found partial, its contribution and its variations (`effect_features`)."""
-    X, feats = feature_library(full, samples, sim)
+    found partial, its contribution and its variations (`effect_features`).
+    ``half_middle_mm``: the model's half middle segment, mm."""
+    X, feats = feature_library(full, samples, sim, half_middle_mm)
     blocks = [channel_features(full, sim)] + list(partial)
     Xc = np.concatenate([b[0] for b in blocks], axis=-1)
     cfeats = [f for b in blocks for f in b[1]]

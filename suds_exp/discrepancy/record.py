@@ -136,6 +136,8 @@ def _record_discoveries(store, conn, run_id: int, result) -> None:
                 "test_loss_after": _num(np.mean(d.test_after)),
                 "gap_closed": _num(d.improvement),
                 "physics": d.physics,
+                "physics_body": d.physics_by_part["body"],
+                "physics_passive": d.physics_by_part["passive"],
                 "leading_features": json.dumps(d.leading),
                 "equations": json.dumps(d.equations()),
                 "n_features": len(d.features),

@@ -222,13 +222,21 @@ def _discovery_parts(result, out: Path) -> list[str]:
         "<h2>Learned correction (no named effect explains the gap)</h2>",
         f"<p>{html.escape(verdict)}: held-out loss {np.mean(d.test_before):.4g} -> "
         f"{np.mean(d.test_after):.4g} ({d.improvement:.0%} closed, p = {d.p_value:.2g}); "
-        f"resembles <b>{html.escape(d.physics or 'nothing')}</b>; leading features "
+        f"resembles <b>{html.escape(d.physics or 'nothing')}</b> "
+        f"({html.escape(_by_part(d))}); leading features "
         f"{html.escape(', '.join(d.leading[:3]))}.</p>",
         "<pre>" + html.escape("\n".join(d.equations()) or "(no term)") + "</pre>",
         table.to_html(index=False, float_format=lambda v: f"{v:.4g}") if not table.empty else "",
         "<h3>Held-out loss per trial, with and without the correction</h3>"
         "<img src='discovery.png' width='100%'>",
     ]
+
+
+def _by_part(d) -> str:
+    """'body velocity: X; passive shape: Y', each part only where it has a term."""
+    names = {"body": "body velocity", "passive": "passive shape"}
+    parts = [f"{names[k]}: {v}" for k, v in d.physics_by_part.items() if v]
+    return "; ".join(parts) or "no term"
 
 
 def _why_partial(step) -> str:

@@ -263,6 +263,7 @@ def discovery_json(d: Discovery | None) -> dict | None:
         "gap_after": float(np.mean(d.test_after)),
         "gap_closed": d.improvement,
         "physics": d.physics,
+        "physics_by_part": d.physics_by_part,
         "leading": d.leading,
         "equations": d.equations(),
         "terms": [
@@ -557,7 +558,16 @@ def explain_gap(
     if not opts.discover:
         return
     step.discovery = d = discover_step(
-        w.full, w.samples, sim, w.measured, w.scales, w.train_ids, opts, rng, partial
+        w.full,
+        w.samples,
+        sim,
+        w.measured,
+        w.scales,
+        w.train_ids,
+        opts,
+        rng,
+        step.model.geometry.middle_length_mm / 2,
+        partial,
     )
     say(
         f"  discovered correction ({'added' if d.significant else 'not added'}, "
