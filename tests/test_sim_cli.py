@@ -79,6 +79,23 @@ def test_config_files_toml_and_json(tmp_path):
         load_config(js)
 
 
+@pytest.mark.parametrize(
+    "values",
+    [
+        {"hinges": {"spring_n_mm_per_rad": -5.0}},
+        {"hinges": {"spring_n_mm_per_rad": 5000.0}},
+        {"hinges": {"preload_rad": -0.1}},
+    ],
+)
+def test_hinge_values_outside_their_range_name_the_setting_and_range(tmp_path, values):
+    (section, params), = values.items()
+    (name, _), = params.items()
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(values))
+    with pytest.raises(ConfigError, match=rf"config\.{section}\.{name}: .* outside its range"):
+        load_config(path)
+
+
 def test_connection_cli_writes_csv_and_figures(tmp_path):
     out = tmp_path / "conn.csv"
     res = runner.invoke(app, ["connection", "--out", str(out), "--grid", "5", "--json"])
