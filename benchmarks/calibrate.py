@@ -20,6 +20,10 @@ Settings:
   effect each finding needs;
 - ``--set EFFECT.PARAM=VALUE ...``: one setting.
 
+``--springs 20,100,300`` runs every setting at each stiffness of the flippers' tape hinges
+(N mm/rad, `Hinges.spring_n_mm_per_rad`, range 5-300; default the nominal 20 only), the
+setting's name then ending in ``@spring=K``.
+
 A reduced campaign takes 1.5-4 min on 2 cores (``--jobs``). Rows are appended to ``--out``
 as settings finish (an interrupted run keeps them; a re-run skips them), and a summary
 (findings holding, on the paper's side, values) is printed for the settings asked for.
@@ -27,6 +31,7 @@ as settings finish (an interrupted run keeps them; a re-run skips them), and a s
     .venv/bin/python benchmarks/calibrate.py --settings nominal,old --out calib.csv
     .venv/bin/python benchmarks/calibrate.py --search 20 --rng 1 --out calib.csv
     .venv/bin/python benchmarks/calibrate.py --ablation --out calib.csv
+    .venv/bin/python benchmarks/calibrate.py --settings nominal,calibrated --springs 20,300
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.ingest import ingest_paths  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
 from suds_exp.sim import SimConfig, apply_effects, effect_library, simulate_dataset  # noqa: E402
+from suds_exp.sim.config import validate_config  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 #: Effects and their settings that describe a robot's variability (issue 17).
@@ -144,8 +150,11 @@ def phase_explained(store: Store, prep: str) -> dict[str, float]:
     return {f"phase_resid_{k}": float(np.median(v)) for k, v in out.items()}
 
 
-def run_setting(name: str, items: list[str], args) -> dict:
+def run_setting(name: str, items: list[str], args, spring: float | None = None) -> dict:
     cfg = apply_effects(SimConfig(), items, param="--set")
+    if spring is not None:
+        cfg.hinges.spring_n_mm_per_rad = spring
+        validate_config(cfg)
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="suds-calibrate-") as tmp:
         ds = simulate_dataset(Path(tmp) / "data", cfg, seed=args.seed)
@@ -204,6 +213,7 @@ def main() -> None:
     ap.add_argument("--n-boot", type=int, default=100, help="bootstrap replicates")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("bench-calibrate.csv"))
+    ap.add_argument("--springs", default="", help="hinge springs, N mm/rad (default nominal)")
     args = ap.parse_args()
     check_space()
     plan: dict[str, list[str]] = {}
@@ -219,12 +229,17 @@ def main() -> None:
     rng = np.random.default_rng(args.rng)
     for i in range(args.search):
         plan[f"search{args.rng}-{i}"] = draw(rng)
+    springs = [float(k) for k in args.springs.split(",") if k]
+    if springs:
+        plan = {f"{name}@spring={k:g}": (items, k) for name, items in plan.items() for k in springs}
+    else:
+        plan = {name: (items, None) for name, items in plan.items()}
     done = pd.read_csv(args.out) if args.out.exists() else pd.DataFrame()
     have = set(zip(done.get("setting", []), done.get("seed", []), strict=False))
-    for name, items in plan.items():
+    for name, (items, spring) in plan.items():
         if (name, args.seed) in have:
             continue
-        row = run_setting(name, items, args)
+        row = run_setting(name, items, args, spring)
         print(json.dumps({k: row[k] for k in ("setting", "items", "seconds")}), flush=True)
         pd.DataFrame([row]).to_csv(args.out, mode="a", header=not args.out.exists(), index=False)
     table = pd.read_csv(args.out)
