@@ -8,13 +8,16 @@ Usage::
     .venv/bin/python benchmarks/findings.py --seeds 0,1,2 --out bench-findings --jobs 2
     # a quick look at a reduced scale
     .venv/bin/python benchmarks/findings.py --seeds 0 --boots 2 --sweep 1-3,30
+    # another robot: a simulator config file, effects over it
+    .venv/bin/python benchmarks/findings.py --seeds 0 --config examples/calibrated_robot.toml
 
 For each dataset seed (``--seeds``): simulate the paper's design with the default
-simulator (`simulate_dataset`), ingest, preprocess (default options), run the campaign
-``--campaign`` with ``--boots`` draws per pair, 30 training cycles and the sweep
-``--sweep`` (default the paper's, ``paper``: 21,000 jobs), leaving out cells the data
-cannot supply when ``--skip-infeasible`` is given. Every step is resumable: a database that
-already holds the data, the version or finished jobs is reused. Then the findings table
+simulator (`simulate_dataset`; the robot of ``--config`` with the effects of ``--set``),
+ingest, preprocess (default options), run the campaign ``--campaign`` with ``--boots``
+draws per pair, 30 training cycles and the sweep ``--sweep`` (default the paper's,
+``paper``: 21,000 jobs), leaving out cells the data cannot supply when
+``--skip-infeasible`` is given. Every step is resumable: a database that already holds
+the data, the version or finished jobs is reused. Then the findings table
 (`suds_exp.analysis.findings`, ``--boot`` replicates) is printed as Markdown per seed,
 and a last table sets the verdicts of all seeds side by side with the count that hold.
 With ``--db`` instead of ``--seeds`` nothing is simulated or run: the campaign is read.
@@ -44,15 +47,17 @@ from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 
-def prepare(db: Path, seed: int, effects: list[str] = ()) -> str:
+def prepare(db: Path, seed: int, effects: list[str] = (), config: Path | None = None) -> str:
     """Simulate and ingest dataset ``seed`` into ``db`` (unless it holds trials already),
-    with the nominal robot changed by ``effects`` (``EFFECT.PARAM=VALUE`` items),
-    preprocess it (idempotent); returns the preprocessing version's name."""
+    with the robot of ``config`` (a simulator config file; default nominal) changed by
+    ``effects`` (``EFFECT.PARAM=VALUE`` items), preprocess it (idempotent); returns the
+    preprocessing version's name."""
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
-    from suds_exp.sim import SimConfig, apply_effects, simulate_dataset
+    from suds_exp.sim import SimConfig, apply_effects, load_config, simulate_dataset
 
-    cfg = apply_effects(SimConfig(), effects, param="--set")
+    base = load_config(config) if config is not None else SimConfig()
+    cfg = apply_effects(base, effects, param="--set")
 
     store = Store(db)
     store.upgrade()
@@ -79,7 +84,10 @@ def main() -> None:
         "--set",
         nargs="*",
         default=[],
-        help="simulator effects over the nominal robot, EFFECT.PARAM=VALUE (with --seeds)",
+        help="simulator effects over the robot, EFFECT.PARAM=VALUE (with --seeds)",
+    )
+    parser.add_argument(
+        "--config", type=Path, help="simulator config file of the robot (default nominal)"
     )
     args = parser.parse_args()
     if (args.db is None) == (args.seeds is None):
@@ -96,7 +104,7 @@ def main() -> None:
         store = Store(db)
         if seed is not None:
             t0 = time.perf_counter()
-            prep = prepare(db, seed, args.set)
+            prep = prepare(db, seed, args.set, args.config)
             t1 = time.perf_counter()
             options = CampaignOptions.parse(
                 prep=prep, boots=args.boots, sweep=args.sweep, train_cycles=30
