@@ -53,8 +53,13 @@ from suds_exp.analysis.findings import findings  # noqa: E402
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
 from suds_exp.ingest import ingest_paths  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
-from suds_exp.sim import SimConfig, apply_effects, effect_library, simulate_dataset  # noqa: E402
-from suds_exp.sim.config import validate_config  # noqa: E402
+from suds_exp.sim import (  # noqa: E402
+    SimConfig,
+    apply_effects,
+    config_from_dict,
+    effect_library,
+    simulate_dataset,
+)
 from suds_exp.store import Store  # noqa: E402
 
 #: Effects and their settings that describe a robot's variability (issue 17).
@@ -153,8 +158,7 @@ def phase_explained(store: Store, prep: str) -> dict[str, float]:
 def run_setting(name: str, items: list[str], args, spring: float | None = None) -> dict:
     cfg = apply_effects(SimConfig(), items, param="--set")
     if spring is not None:
-        cfg.hinges.spring_n_mm_per_rad = spring
-        validate_config(cfg)
+        cfg = config_from_dict({"hinges": {"spring_n_mm_per_rad": spring}}, base=cfg)
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="suds-calibrate-") as tmp:
         ds = simulate_dataset(Path(tmp) / "data", cfg, seed=args.seed)

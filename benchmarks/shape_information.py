@@ -49,12 +49,12 @@ from suds_exp.preprocess import get_version, preprocess  # noqa: E402
 from suds_exp.sim import (  # noqa: E402
     SimConfig,
     apply_effects,
+    config_from_dict,
     load_config,
     plan_trials,
     simulate_dataset,
     simulate_trials,
 )
-from suds_exp.sim.config import validate_config  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 
@@ -178,9 +178,7 @@ def main() -> None:
         )
         print("|---|---|---|---|---|---|---|---|")
     for spring in springs:
-        cfg = base.copy()
-        cfg.hinges.spring_n_mm_per_rad = spring
-        validate_config(cfg)
+        cfg = config_from_dict({"hinges": {"spring_n_mm_per_rad": spring}}, base=base)
         if args.pipeline:
             m = pipeline(cfg, args.seed, args.order)
             print(
