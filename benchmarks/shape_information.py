@@ -59,11 +59,9 @@ from suds_exp.store import Store  # noqa: E402
 
 
 def basis(phase: np.ndarray, order: int, x: np.ndarray | None = None) -> np.ndarray:
-    """Fourier basis of the phase (n, 2 order + 1), times each column of x when given."""
-    cols = [np.ones_like(phase)]
-    for k in range(1, order + 1):
-        cols += [np.cos(k * phase), np.sin(k * phase)]
-    b = np.stack(cols, axis=1)
+    """`fourier.basis` of the phase (n, 2 order + 1), and its product with each column of
+    x when given (a phase-varying linear map)."""
+    b = fourier.basis(phase, order)
     if x is None:
         return b
     return np.concatenate([b] + [b * c[:, None] for c in x.T], axis=1)
