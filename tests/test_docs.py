@@ -100,3 +100,41 @@ def test_skipped_blocks_say_why():
         for line in page.read_text().splitlines():
             if line.startswith("<!-- skip-test"):
                 assert re.match(r"<!-- skip-test: \S.* -->$", line), f"{page}: {line}"
+
+
+def generators():
+    """docs/hooks/suds_docs.py, the MkDocs hook that writes the generated reference."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("suds_docs", DOCS / "hooks" / "suds_docs.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_command_is_in_the_cli_reference():
+    import typer
+
+    page = generators().cli()
+    for name in typer.main.get_command(app).commands:
+        assert f"## `suds-exp {name}`" in page, name
+
+
+def test_every_table_view_and_parameter_is_in_the_reference(tmp_path, monkeypatch):
+    from suds_exp.preprocess.params import DEFAULTS
+    from suds_exp.store import Store
+
+    gen = generators()
+    monkeypatch.syspath_prepend(str(DOCS / "hooks"))
+    page = gen.database()
+    store = Store(tmp_path / "x.duckdb")
+    store.upgrade()
+    names = store.query_df(
+        "SELECT table_name FROM information_schema.tables WHERE table_schema = 'main'"
+    ).table_name
+    assert len(names) >= 20
+    for name in names:
+        assert f"### `{name}`" in page, name
+    params = gen.preprocessing_parameters()
+    for key in DEFAULTS:
+        assert f"| `{key}` |" in params, key

@@ -18,8 +18,7 @@ COLUMN_NOTES: dict[tuple[str, str], str] = {
     ("trials", "content_hash"): "SHA-256 of the file's bytes (unique: the same file is "
     "never stored twice)",
     ("trials", "format"): "reader that read it, e.g. `qtm-tsv`, `c3d`, `csv`",
-    ("trials", "gait"): "`S+`, `S-`, `O`, `D-`, `D+`, or NULL when no manifest row named "
-    "the file",
+    ("trials", "gait"): "`S+`, `S-`, `O`, `D-`, `D+`, or NULL when no manifest row named the file",
     ("trials", "frequency_hz"): "gait frequency, Hz (NULL without a condition)",
     ("trials", "repeat"): "repeat number within the condition",
     ("trials", "sample_rate_hz"): "capture rate, Hz",
@@ -39,8 +38,7 @@ COLUMN_NOTES: dict[tuple[str, str], str] = {
     ("markers", "z"): "position, mm",
     ("markers", "missing"): "true when the marker was not seen in that frame",
     # preprocessing
-    ("prep_versions", "params"): "the full parameter set (defaults filled in), canonical "
-    "JSON",
+    ("prep_versions", "params"): "the full parameter set (defaults filled in), canonical JSON",
     ("prep_versions", "params_hash"): "SHA-256 of `params`: the same parameters are the "
     "same version",
     ("prep_versions", "k"): "passive components kept as r_p",

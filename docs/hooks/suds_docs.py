@@ -9,10 +9,9 @@ so the reference cannot drift from what the package does:
   ``migrations/*.sql`` and the migration that created it;
 - ``preprocessing-parameters``: `suds_exp.preprocess.params.DEFAULTS` with the comments
   written beside each entry in ``params.py``, and the presets;
-- ``simulator-effects``: `suds_exp.sim.effect_library()`.
-
-The command-line reference is rendered by mkdocs-click from ``cli_command.command``
-(this folder), which this hook makes importable.
+- ``simulator-effects``: `suds_exp.sim.effect_library()`;
+- ``cli``: every command of the typer app ``cli:app``, by typer's own documentation
+  generator (``typer cli utils docs``), the same text ``--help`` prints.
 """
 
 from __future__ import annotations
@@ -28,7 +27,7 @@ MARKER = re.compile(r"^<!-- generated: ([a-z-]+) -->$", re.MULTILINE)
 
 
 def on_config(config):
-    # mkdocs-click imports the click command by module name: make this folder importable
+    # column_notes.py, beside this file, is imported by the database generator
     if str(HERE) not in sys.path:
         sys.path.insert(0, str(HERE))
     return config
@@ -200,7 +199,24 @@ def simulator_effects() -> str:
     return "\n".join(out)
 
 
+# --- command line ----------------------------------------------------------------------
+
+
+def cli() -> str:
+    """Typer's own Markdown for every command of ``cli:app``, headings one level down."""
+    import typer.cli
+    from typer.testing import CliRunner
+
+    # `typer cli utils docs --name suds-exp`, run in this process
+    args = ["cli", "utils", "docs", "--name", "suds-exp"]
+    done = CliRunner().invoke(typer.cli.app, args)
+    if done.exit_code != 0:
+        raise RuntimeError(f"typer's docs generator failed:\n{done.output}")
+    return re.sub(r"^(#+) ", r"#\1 ", done.stdout, flags=re.MULTILINE)
+
+
 GENERATORS = {
+    "cli": cli,
     "database": database,
     "preprocessing-parameters": preprocessing_parameters,
     "simulator-effects": simulator_effects,
