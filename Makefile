@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow browser lint lint-imports clean
+.PHONY: demo test test-slow browser lint lint-imports docs clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -36,5 +36,14 @@ lint: $(STAMP)
 lint-imports: $(STAMP)
 	$(BIN)/lint-imports
 
+# The documentation site (mkdocs.yml) into site/, warnings as errors; needs the docs extra.
+DOCS_STAMP := $(VENV)/.docs-installed
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dev,docs]'
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
 clean:
-	rm -rf $(VENV) *.duckdb reports/*/ sim-data
+	rm -rf $(VENV) *.duckdb reports/*/ sim-data site

@@ -555,7 +555,7 @@ def findings(
     json_: JsonOption = False,
 ) -> None:
     """The paper's findings F1-F10 measured on a campaign: statistic, value, 95 % bootstrap
-    interval, holds / unclear / fails / not measurable (definitions in the README).
+    interval, holds / unclear / fails / not measurable (definitions: docs/explanation/findings.md).
 
     Example: suds-exp findings paper --json
     """

@@ -216,8 +216,8 @@ def _findings_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
             "the paper's side of the threshold; unclear: the value is, the interval is not "
             "all; fails: the value is on the other side; not measurable: the campaign lacks "
             "the data (reason given). Ratios are of median RMS errors of vx; same-condition "
-            f"pairs at the main size ({a['main_cycles']} cycles) unless said. The README "
-            "defines every statistic.</p>",
+            f"pairs at the main size ({a['main_cycles']} cycles) unless said. The "
+            "documentation (docs/explanation/findings.md) defines every statistic.</p>",
             to_html(findings_display(table)),
             f"<p>Files (with each statistic's definition): {_files(files)}</p>",
         ]

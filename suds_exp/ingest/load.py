@@ -140,6 +140,8 @@ def ingest_paths(
 ) -> list[IngestResult]:
     """Ingest capture files and folders, each file in its own transaction.
 
+    The manifest and layout are checked before any file is read.
+
     Parameters
     ----------
     store : Store
@@ -158,8 +160,6 @@ def ingest_paths(
         Go on past a bad file: its result has status ``"failed"`` and its one-line
         reason, and nothing of it is stored. Without it, the first bad file stops the run
         with an `IngestError`. Either way the files stored before stay stored.
-
-    The manifest and layout are checked before any file is read.
     """
     conditions = read_manifest(manifest) if manifest is not None else {}
     roles = read_layout(layout) if layout is not None else None

@@ -89,6 +89,10 @@ class _PassiveSubset(OnlineGMR):
 class GradualGMRSuds(Learner):
     """Online GMR that adds passive coordinates rp_1, rp_2, ... one at a time.
 
+    Fitted attributes: `passive_columns_` (coordinates in use), `added_` (list of
+    {"column", "n_seen", "batch"}), `current_`, `candidate_` (None when every coordinate
+    is in), `n_seen_`, `n_batches_`, `gain_history_` (per scored batch: mean gain).
+
     Parameters
     ----------
     n_components, reg_covar, forgetting, warmup_samples, sweeps, min_share,
@@ -102,10 +106,6 @@ class GradualGMRSuds(Learner):
         ... and the gain's t-statistic over the window's batches (mean / standard error):
         one batch's gain varies by about 0.1 nats per sample on a coordinate that carries
         nothing, so a mean gain alone lets noise in now and then.
-
-    Fitted attributes: `passive_columns_` (coordinates in use), `added_` (list of
-    {"column", "n_seen", "batch"}), `current_`, `candidate_` (None when every coordinate
-    is in), `n_seen_`, `n_batches_`, `gain_history_` (per scored batch: mean gain).
     """
 
     name = "GradualGMR+SUDS"

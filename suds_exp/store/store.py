@@ -21,15 +21,15 @@ _frame_names = itertools.count()
 class Store:
     """A DuckDB database file, opened only for the length of each block.
 
-    Parameters
-    ----------
-    path : path-like, optional
-        The database file; ``$SUDS_DB`` or ``./suds.duckdb`` when None.
-
     ``with store.write() as conn`` gives a SQLAlchemy connection inside one transaction
     (committed when the block ends, rolled back if it raises) after applying pending
     migrations; ``with store.read() as conn`` gives a read-only one. Both wait briefly
     when another process holds the file.
+
+    Parameters
+    ----------
+    path : path-like, optional
+        The database file; ``$SUDS_DB`` or ``./suds.duckdb`` when None.
     """
 
     def __init__(self, path: str | Path | None = None):
