@@ -227,8 +227,7 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
             )
         if frame and len(frame) < 2:
             raise BodyError(
-                f"{src}: {where}.frame: {len(frame)} marker(s); a segment's pose needs at "
-                "least 2"
+                f"{src}: {where}.frame: {len(frame)} marker(s); a segment's pose needs at least 2"
             )
         from_joints = raw.get("from_joints", False) is True
         if from_joints and markers:

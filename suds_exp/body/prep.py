@@ -34,6 +34,7 @@ from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.params import DEFAULTS, params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
 from suds_exp.preprocess.pipeline import (
+    PLANAR_Z,
     NewFit,
     PrepResult,
     find_version,
@@ -79,8 +80,7 @@ def preprocess_body(
         return preprocess(store, name, params, trials, progress, preset=preset)
     if preset is not None:
         raise BodyError(
-            f"{body.source}: preset {preset!r} describes the swimmer; this body takes params "
-            "only"
+            f"{body.source}: preset {preset!r} describes the swimmer; this body takes params only"
         )
     if body.chain is None:
         model = SegmentModel(body)
@@ -94,7 +94,8 @@ def _chain_tracks(conn: sa.Connection, body: Body, meta_row) -> tuple[np.ndarray
     names = body.chain.markers
     df = Store.frame(
         conn,
-        "SELECT frame, t, list_position($names, marker) - 1 AS k, x, y, z FROM markers "
+        f"SELECT frame, t, list_position($names, marker) - 1 AS k, x, y, {PLANAR_Z} AS z "
+        "FROM markers "
         "WHERE trial_id = $tid AND list_contains($names, marker) ORDER BY frame, k",
         {"names": list(names), "tid": int(meta_row.id)},
     )

@@ -42,6 +42,9 @@ from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
 from suds_exp.store import Store
 from suds_exp.store.tables import trials
 
+#: A 2-D track (keypoints: z stored NULL where x, y are present) lies in the plane z = 0.
+PLANAR_Z = "CASE WHEN missing THEN z ELSE coalesce(z, 0) END"
+
 #: Trials are written in batches of about this many frames, one transaction each (fewer
 #: transactions are faster; a batch is what an interrupted run may have to redo).
 WRITE_BATCH_FRAMES = 50_000
@@ -113,7 +116,8 @@ def _read_tracks(conn: sa.Connection, meta: pd.DataFrame, model: BodyModel) -> d
     for names, ids in by_layout.items():
         df = Store.frame(
             conn,
-            "SELECT trial_id, frame, t, list_position($names, marker) - 1 AS role, x, y, z "
+            "SELECT trial_id, frame, t, list_position($names, marker) - 1 AS role, x, y, "
+            f"{PLANAR_Z} AS z "
             "FROM markers WHERE trial_id IN (SELECT unnest($ids::INTEGER[])) "
             "AND list_contains($names, marker) ORDER BY trial_id, frame, role",
             {"names": list(names), "ids": ids},
