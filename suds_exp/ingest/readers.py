@@ -15,6 +15,7 @@ from suds_exp.ingest.pose import PoseOptions, pose_software, read_pose
 from suds_exp.ingest.qtm import read_qtm_tsv
 from suds_exp.ingest.trc import read_trc
 from suds_exp.ingest.vicon import is_vicon_csv, read_vicon_csv
+from suds_exp.ingest.worm_tracker import read_wt2_features
 
 
 def _text(data: bytes) -> str:
@@ -44,6 +45,7 @@ READERS: dict[str, tuple[str, Callable[[Path, bytes], Capture]]] = {
     # keypoint files (suds_exp.ingest.pose); a keypoint .csv is told by its content
     ".h5": ("deeplabcut or sleap", read_pose),
     ".slp": ("sleap", read_pose),
+    ".mat": ("wt2-features", read_wt2_features),
 }
 
 
