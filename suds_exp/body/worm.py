@@ -10,7 +10,8 @@ what the Schafer lab's code measured on the same skeleton (Yemini et al. 2013):
 - our mean forward speed (vx, mm/s) against the median midbody speed (signed, + towards
   the head);
 - our number of waves along the body (the phase of shape modes 1 + i 2 from head to
-  tail) against the median length over the median primary wavelength.
+  tail, scaled from the span of the chord angles to the whole skeleton) against the
+  median length over the median primary wavelength.
 
 The learners are then fitted on the earlier phase cycles and tested on the later ones.
 """
@@ -92,7 +93,9 @@ def run_worm(
 
     ``train_cycles``: phase cycles the learners train on (default: the first two thirds of
     the complete ones); the later cycles test. Returns ``version``,
-    ``explained_variance_ratio``, ``phase_rate_hz``, ``waves_along_body``,
+    ``explained_variance_ratio``, ``phase_rate_hz``, ``waves_along_body`` (between the
+    first and last chord angles), ``waves_per_body_length`` (the same scaled to the whole
+    skeleton, head to tail),
     ``forward_speed_mm_s`` (mean vx), ``n_samples``, ``n_cycles`` (complete cycles),
     ``train_cycles``, ``reference`` (`tracker_reference`) and ``errors`` (a DataFrame, rows
     as `suds_exp.body.real_snake.holdout_errors`).
@@ -102,6 +105,10 @@ def run_worm(
     result = preprocess_body(store, worm_body(step), None, WORM_PARAMS, progress=False)
     version = get_version(store, result.version_id)
     samples = version.samples()
+    waves = wave_summary(samples, version.pca.components_)
+    # the angles sit at the inner points: they span (n - 3) of the n - 1 equal chords
+    n_points = len(worm_body(step).chain.markers)
+    waves["waves_per_body_length"] = waves["waves_along_body"] * (n_points - 1) / (n_points - 3)
     sizes = samples.groupby("cycle").size()
     complete = int((sizes >= 0.5 * sizes.median()).sum())
     if train_cycles is None:
@@ -109,7 +116,7 @@ def run_worm(
     return {
         "version": result.version_id,
         "explained_variance_ratio": result.explained_variance_ratio,
-        **wave_summary(samples, version.pca.components_),
+        **waves,
         "forward_speed_mm_s": float(samples.vx.mean()),
         "n_samples": len(samples),
         "n_cycles": complete,
