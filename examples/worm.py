@@ -56,6 +56,8 @@ def main() -> None:
     )
     print(f"learners: train on cycles 1-{out['train_cycles']}, test on the later ones")
     print(out["errors"].round(1).to_string(index=False))
+    print("in sample (fitted and scored on every cycle)")
+    print(out["in_sample"].round(1).to_string(index=False))
     print(f"{time.perf_counter() - started:.1f} s")
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from suds_exp.body.description import Body, parse_body
 from suds_exp.body.prep import preprocess_body
-from suds_exp.body.real_snake import CHAIN_MODELS, holdout_by_cycles, wave_summary
+from suds_exp.body.real_snake import CHAIN_MODELS, holdout_by_cycles, split_errors, wave_summary
 from suds_exp.errors import IngestError
 from suds_exp.ingest import ingest_paths
 from suds_exp.ingest.worm_tracker import skeleton_names
@@ -98,7 +98,8 @@ def run_worm(
     skeleton, head to tail),
     ``forward_speed_mm_s`` (mean vx), ``n_samples``, ``n_cycles`` (complete cycles),
     ``train_cycles``, ``reference`` (`tracker_reference`) and ``errors`` (a DataFrame, rows
-    as `suds_exp.body.real_snake.holdout_errors`).
+    as `suds_exp.body.real_snake.holdout_errors`) and ``in_sample`` (the same rows, fitted
+    and scored on every cycle).
     """
     store = Store(db)
     ingest_paths(store, [Path(features)], progress=False)
@@ -123,4 +124,6 @@ def run_worm(
         "train_cycles": train_cycles,
         "reference": tracker_reference(features),
         "errors": holdout_by_cycles(samples, train_cycles, models),
+        # how much of vx the phase and shape explain at all, fitted and scored on every cycle
+        "in_sample": split_errors(samples, samples, models),
     }
