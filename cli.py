@@ -6,6 +6,7 @@ Each command parses options and calls one library function; the work lives in
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import re
 from pathlib import Path
@@ -107,17 +108,35 @@ def ingest(
         Path | None, typer.Option(help="CSV file,gait,frequency_hz,repeat,notes.")
     ] = None,
     layout: Annotated[Path | None, typer.Option(help="CSV role,marker for the 11 roles.")] = None,
+    software: Annotated[
+        str | None,
+        typer.Option(
+            help="Keypoint files' tracker: deeplabcut, sleap, lightning-pose, anipose "
+            "(default: told by the file)."
+        ),
+    ] = None,
+    fps: Annotated[
+        float | None, typer.Option(help="Keypoint files' frame rate, when the file lacks it.")
+    ] = None,
+    mm_per_px: Annotated[
+        float | None, typer.Option(help="Scale of 2-D keypoints, mm per pixel.")
+    ] = None,
+    confidence_threshold: Annotated[
+        float | None,
+        typer.Option(help="Keypoints below this confidence are missing (default 0.6)."),
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
 ) -> None:
-    """Ingest QTM TSV, C3D, Vicon Nexus / Motive / marker CSV and TRC files.
+    """Ingest QTM TSV, C3D, Vicon Nexus / Motive / marker CSV and TRC files, and keypoint
+    files of DeepLabCut, SLEAP, Lightning Pose and Anipose (needs suds-exp[pose]).
 
     Each file is one transaction; a bad file is reported in one line and the others are
     still stored (exit status 2 at the end). Example: suds-exp ingest data/ --manifest
-    data/manifest.csv
+    data/manifest.csv; suds-exp ingest mouse.h5 --fps 30 --mm-per-px 0.1
     """
-    from suds_exp.ingest import ingest_paths
+    from suds_exp.ingest import PoseOptions, ingest_paths
 
     results = ingest_paths(
         open_store(db),
@@ -126,7 +145,13 @@ def ingest(
         layout,
         progress=not (quiet or json_),
         keep_going=True,
+        pose=PoseOptions(software, fps, mm_per_px, confidence_threshold),
     )
+    # a refusal in the command line's words (a parameter named by its flag)
+    results = [
+        dataclasses.replace(r, message=user_message(r.error)) if r.error is not None else r
+        for r in results
+    ]
     failed = [r for r in results if r.status == "failed"]
     if json_:
         console.print_json(

@@ -14,6 +14,7 @@ from suds_exp.body.description import (
     parse_body,
 )
 from suds_exp.body.prep import preprocess_body
+from suds_exp.body.segments import SegmentModel
 
 __all__ = [
     "BUILTIN",
@@ -23,6 +24,7 @@ __all__ = [
     "ChainGeometry",
     "Joint",
     "Segment",
+    "SegmentModel",
     "chain_geometry",
     "check_markers",
     "load_body",

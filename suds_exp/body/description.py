@@ -5,12 +5,19 @@ Two kinds of body:
 - **segments**: rigid segments, each with its markers and their roles (at least 2
   markers, or none with ``from_joints = true`` when the segment is located by its joints,
   as the swimmer's middle segment is), joints between segments (``actuated`` or
-  ``passive``; they must form a tree), and passive markers hanging from a segment::
+  ``passive``; they must form a tree in which each segment is the child of at most one
+  joint), and passive markers hanging from a segment. ``frame`` lists the markers fixed
+  on a segment that give its pose (default: all of them; the first two set its origin,
+  their midpoint, and its first direction); its other markers are measured in its frame
+  as passive state, like the passive markers. A joint's angle is the heading of its
+  child's axis minus its parent's: write each joint from the tail side (parent) to the
+  head side (child)::
 
       name = "swimmer"
       body_frame = "middle"
       [segments.head]
       markers = { head_top_1 = "top", head_top_2 = "top", head_spoke = "spoke" }
+      frame = ["head_top_1", "head_top_2"]
       [[joints]]
       name = "phi1"
       parent = "middle"
@@ -54,6 +61,12 @@ class Segment:
     #: marker name -> role on the segment (free text, e.g. "top", "spoke")
     markers: dict[str, str]
     from_joints: bool = False
+    #: the markers that give the segment's pose, in order (empty: all its markers)
+    frame: list[str] = field(default_factory=list)
+
+    @property
+    def frame_markers(self) -> list[str]:
+        return list(self.frame) if self.frame else list(self.markers)
 
 
 @dataclass(frozen=True)
@@ -97,11 +110,11 @@ class Body:
 
     def is_swimmer(self) -> bool:
         """True for the paper's swimmer: the 11 roles on head/middle/tail, two motors."""
-        actuated = {(j.parent, j.child) for j in self.joints if j.kind == "actuated"}
+        actuated = {frozenset((j.parent, j.child)) for j in self.joints if j.kind == "actuated"}
         return (
             self.chain is None
             and sorted(self.markers) == sorted(ROLES)
-            and actuated == {("middle", "head"), ("middle", "tail")}
+            and actuated == {frozenset(("middle", "head")), frozenset(("middle", "tail"))}
             and self.body_frame == "middle"
         )
 
@@ -204,8 +217,18 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
     for seg_name, raw in _table(src, doc["segments"], "segments").items():
         where = f"segments.{seg_name}"
         raw = _table(src, raw, where)
-        _known_keys(src, raw, ("markers", "from_joints"), where)
+        _known_keys(src, raw, ("markers", "from_joints", "frame"), where)
         markers = _table(src, raw.get("markers", {}), f"{where}.markers")
+        frame = raw.get("frame", [])
+        if not isinstance(frame, list) or any(m not in markers for m in frame):
+            raise BodyError(
+                f"{src}: {where}.frame: expected a list of the segment's own markers "
+                f"({', '.join(markers)})"
+            )
+        if frame and len(frame) < 2:
+            raise BodyError(
+                f"{src}: {where}.frame: {len(frame)} marker(s); a segment's pose needs at least 2"
+            )
         from_joints = raw.get("from_joints", False) is True
         if from_joints and markers:
             raise BodyError(f"{src}: {where}: from_joints = true but it also lists markers")
@@ -222,7 +245,7 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
                     f"{src}: {where}.markers.{marker}: already on segment {owner[marker]!r}"
                 )
             owner[marker] = seg_name
-        segments.append(Segment(seg_name, dict(markers), from_joints))
+        segments.append(Segment(seg_name, dict(markers), from_joints, list(frame)))
     names = [s.name for s in segments]
     joints = []
     raw_joints = doc.get("joints", [])
@@ -274,7 +297,15 @@ def _check_tree(src: str, names: list[str], joints: list[Joint]) -> None:
             n = root[n]
         return n
 
+    parent_of: dict[str, str] = {}
     for i, j in enumerate(joints):
+        if j.child in parent_of:
+            raise BodyError(
+                f"{src}: joints[{i}] {j.name!r}: {j.child!r} is already the child of joint "
+                f"{parent_of[j.child]!r}; a segment has at most one parent joint (write "
+                "each joint from the tail side to the head side)"
+            )
+        parent_of[j.child] = j.name
         a, b = find(j.parent), find(j.child)
         if a == b:
             raise BodyError(

@@ -1,7 +1,9 @@
 """`preprocess_body`: preprocessing driven by a body description.
 
 The swimmer's description runs the standard pipeline (`suds_exp.preprocess.preprocess`)
-unchanged. A chain description (snake, fish) gives a version whose samples hold:
+unchanged. Any other description of rigid segments runs the same pipeline with its own
+geometry (`suds_exp.body.segments.SegmentModel`, the pipeline's body hook). A chain
+description (snake, fish) gives a version whose samples hold:
 
 - ``ra_1, ra_2``: the first two shape modes (rad; PCA of the chord angles, fitted on the
   version's trials), the driven travelling wave whose phase Phaser estimates;
@@ -26,11 +28,13 @@ import sqlalchemy as sa
 
 from suds_exp.body.chain_shape import chain_geometry
 from suds_exp.body.description import Body, BodyError, check_markers
+from suds_exp.body.segments import SWIMMER_ONLY, SegmentModel
 from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
-from suds_exp.preprocess.params import params_hash, resolve_params
+from suds_exp.preprocess.params import DEFAULTS, params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
 from suds_exp.preprocess.pipeline import (
+    PLANAR_Z,
     NewFit,
     PrepResult,
     find_version,
@@ -60,27 +64,29 @@ def preprocess_body(
     progress: bool = True,
     preset: str | None = None,
 ) -> PrepResult:
-    """Preprocess trials of ``body``: the standard pipeline for the swimmer, else a chain.
+    """Preprocess trials of ``body``: the standard pipeline for the swimmer, the pipeline
+    with the body's geometry for other segment bodies, else a chain.
 
-    Parameters as `suds_exp.preprocess.preprocess` (a ``preset`` is the swimmer's only);
-    ``params["k"]`` is set from the
-    chain's ``modes`` (k = modes - 2). Raises `BodyError` for a description the trials do
-    not fit (an unknown marker) or a segment body other than the swimmer (not supported
-    yet) or a ``reduction`` other than PCA for a chain, `PreprocessError` as the standard
-    pipeline does.
+    Parameters as `suds_exp.preprocess.preprocess` (a ``preset`` is the swimmer's only).
+    For a segment body, the swimmer-only parameters default to their generic values
+    (``body_fit=segments``, ``tail_fit=rigid``, ``ra_repr=angles``) and ``k`` to at
+    most the size of its passive state; for a chain
+    ``params["k"]`` is set from its ``modes`` (k = modes - 2). Raises `BodyError` for a
+    description the trials do not fit (an unknown marker), a body the generic pipeline
+    cannot preprocess (`SegmentModel`), or a ``reduction`` other than PCA;
+    `PreprocessError` as the standard pipeline does.
     """
     if body.is_swimmer():
         return preprocess(store, name, params, trials, progress, preset=preset)
     if preset is not None:
         raise BodyError(
-            f"{body.source}: preset {preset!r} describes the swimmer; a chain takes params only"
+            f"{body.source}: preset {preset!r} describes the swimmer; this body takes params only"
         )
     if body.chain is None:
-        raise BodyError(
-            f"{body.source}: segment bodies other than the swimmer's (11 roles, motors at "
-            "the middle segment's ends) are not preprocessed yet; describe a continuous "
-            "body as a [chain]"
-        )
+        model = SegmentModel(body)
+        # k defaults to the swimmer's 4 unless the body's passive state has fewer numbers
+        given = {"k": min(DEFAULTS["k"], model.n_passive), **SWIMMER_ONLY, **dict(params or {})}
+        return preprocess(store, name, given, trials, progress, body=model)
     return _preprocess_chain(store, body, name, params, trials, progress)
 
 
@@ -88,7 +94,8 @@ def _chain_tracks(conn: sa.Connection, body: Body, meta_row) -> tuple[np.ndarray
     names = body.chain.markers
     df = Store.frame(
         conn,
-        "SELECT frame, t, list_position($names, marker) - 1 AS k, x, y, z FROM markers "
+        f"SELECT frame, t, list_position($names, marker) - 1 AS k, x, y, {PLANAR_Z} AS z "
+        "FROM markers "
         "WHERE trial_id = $tid AND list_contains($names, marker) ORDER BY frame, k",
         {"names": list(names), "tid": int(meta_row.id)},
     )

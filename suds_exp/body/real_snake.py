@@ -39,7 +39,21 @@ def holdout_errors(
     position = samples.groupby("trial_id").cumcount()
     size = samples.groupby("trial_id").trial_id.transform("size")
     is_train = position < np.floor(train_fraction * size)
-    train, test = samples[is_train], samples[~is_train]
+    return split_errors(samples[is_train], samples[~is_train], models)
+
+
+def holdout_by_cycles(samples: pd.DataFrame, train_cycles: int, models=CHAIN_MODELS):
+    """Fit each learner on the first ``train_cycles`` phase cycles of every trial (its
+    ``cycle`` below the trial's first cycle + ``train_cycles``), test on the later ones.
+    Rows as `holdout_errors`."""
+    first = samples.groupby("trial_id").cycle.transform("min")
+    is_train = samples.cycle < first + train_cycles
+    return split_errors(samples[is_train], samples[~is_train], models)
+
+
+def split_errors(train: pd.DataFrame, test: pd.DataFrame, models=CHAIN_MODELS) -> pd.DataFrame:
+    """Each learner fitted on ``train`` and tested on ``test`` (samples frames), beside
+    the constant predictor (the training mean): rows as `holdout_errors`."""
     rms_vx = float(np.sqrt(np.mean(test.vx**2)))
     rms_wz = float(np.sqrt(np.mean(test.wz**2)))
 

@@ -20,7 +20,8 @@ class Capture:
     path : Path
         The file it was read from.
     format : str
-        ``"qtm-tsv"``, ``"c3d"``, ``"csv"``, ``"vicon-csv"``, ``"motive-csv"`` or ``"trc"``.
+        ``"qtm-tsv"``, ``"c3d"``, ``"csv"``, ``"vicon-csv"``, ``"motive-csv"``, ``"trc"``,
+        or a keypoint tracker's name (``"deeplabcut"``, ``"sleap"``, ...).
     sample_rate_hz : float
         Capture rate, Hz.
     marker_names : list of str
@@ -79,10 +80,13 @@ class Capture:
         return self
 
     def long_frame(self, trial_id: int) -> pd.DataFrame:
-        """The capture as rows of the ``markers`` table (trial, frame, t, marker, x, y, z)."""
+        """The capture as rows of the ``markers`` table (trial, frame, t, marker, x, y, z);
+        a 2-D capture (``meta["dims"] == 2``, keypoints) has z NULL and is missing where x
+        or y is."""
         n_f, n_m = self.n_frames, len(self.marker_names)
         xyz = self.xyz.reshape(n_f * n_m, 3)
-        missing = ~np.all(np.isfinite(xyz), axis=1)
+        dims = int(self.meta.get("dims", 3))
+        missing = ~np.all(np.isfinite(xyz[:, :dims]), axis=1)
         xyz = np.where(missing[:, None], np.nan, xyz)
         return pd.DataFrame(
             {

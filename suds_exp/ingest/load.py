@@ -10,6 +10,7 @@ import sqlalchemy as sa
 from suds_exp.errors import IngestError
 from suds_exp.ingest.layout import check_layout, layout_json, read_layout
 from suds_exp.ingest.manifest import Condition, read_manifest
+from suds_exp.ingest.pose import PoseOptions
 from suds_exp.ingest.readers import READERS, read_capture
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
@@ -27,6 +28,8 @@ class IngestResult:
     trial_id: int | None
     n_frames: int
     message: str
+    #: the refusal itself (``failed`` only): its ``param`` names what to change
+    error: IngestError | None = None
 
 
 def expand_paths(paths: list[Path], exclude: set[Path]) -> list[Path]:
@@ -59,20 +62,22 @@ def ingest_file(
     layout: dict[str, str] | None = None,
     layout_source: str = "layout",
     conn: sa.Connection | None = None,
+    pose: PoseOptions | None = None,
 ) -> IngestResult:
     """Read, validate and store one capture file in one transaction.
 
     A file whose content hash is already stored is skipped. Raises `IngestError` (and
     writes nothing) for a bad file, a layout naming markers the file lacks, or a
     condition already taken by a different capture. ``conn``: a connection from
-    ``store.writer()`` to reuse (the transaction is still this file's own).
+    ``store.writer()`` to reuse (the transaction is still this file's own). ``pose``: how
+    to read keypoint files (`suds_exp.ingest.pose.PoseOptions`).
     """
-    capture, digest = read_capture(path)
+    capture, digest = read_capture(path, pose)
     if layout is not None:
         check_layout(layout, capture.marker_names, layout_source, path)
     if conn is None:
         with store.writer() as own:
-            return ingest_file(store, path, condition, layout, layout_source, own)
+            return ingest_file(store, path, condition, layout, layout_source, own, pose)
     with conn.begin():
         existing = conn.execute(
             sa.select(trials.c.id).where(trials.c.content_hash == digest)
@@ -137,6 +142,7 @@ def ingest_paths(
     layout: Path | None = None,
     progress: bool = True,
     keep_going: bool = False,
+    pose: PoseOptions | None = None,
 ) -> list[IngestResult]:
     """Ingest capture files and folders, each file in its own transaction.
 
@@ -160,7 +166,12 @@ def ingest_paths(
         Go on past a bad file: its result has status ``"failed"`` and its one-line
         reason, and nothing of it is stored. Without it, the first bad file stops the run
         with an `IngestError`. Either way the files stored before stay stored.
+    pose : PoseOptions, optional
+        How to read keypoint files (DeepLabCut, SLEAP, Lightning Pose, Anipose): tracker,
+        frame rate, mm per pixel, confidence threshold (`suds_exp.ingest.pose`).
     """
+    if pose is not None:
+        pose.check()
     conditions = read_manifest(manifest) if manifest is not None else {}
     roles = read_layout(layout) if layout is not None else None
     exclude = {Path(p).resolve() for p in (manifest, layout) if p is not None}
@@ -177,10 +188,10 @@ def ingest_paths(
         for path in files:
             condition = conditions.get(Path(path).resolve())
             try:
-                results.append(ingest_file(store, path, condition, roles, source, conn))
+                results.append(ingest_file(store, path, condition, roles, source, conn, pose))
             except IngestError as exc:
                 if not keep_going:
                     raise
-                results.append(IngestResult(Path(path), "failed", None, 0, str(exc)))
+                results.append(IngestResult(Path(path), "failed", None, 0, str(exc), exc))
             advance()
     return results

@@ -11,9 +11,11 @@ from suds_exp.ingest.c3d_reader import read_c3d
 from suds_exp.ingest.capture import Capture
 from suds_exp.ingest.csv_reader import read_marker_csv
 from suds_exp.ingest.motive import is_motive_csv, read_motive_csv
+from suds_exp.ingest.pose import PoseOptions, pose_software, read_pose
 from suds_exp.ingest.qtm import read_qtm_tsv
 from suds_exp.ingest.trc import read_trc
 from suds_exp.ingest.vicon import is_vicon_csv, read_vicon_csv
+from suds_exp.ingest.worm_tracker import read_wt2_features
 
 
 def _text(data: bytes) -> str:
@@ -40,6 +42,10 @@ READERS: dict[str, tuple[str, Callable[[Path, bytes], Capture]]] = {
     ".c3d": ("c3d", read_c3d),
     ".csv": ("csv, vicon-csv or motive-csv", _read_any_csv),
     ".trc": ("trc", lambda p, b: read_trc(p, _text(b))),
+    # keypoint files (suds_exp.ingest.pose); a keypoint .csv is told by its content
+    ".h5": ("deeplabcut or sleap", read_pose),
+    ".slp": ("sleap", read_pose),
+    ".mat": ("wt2-features", read_wt2_features),
 }
 
 
@@ -48,8 +54,10 @@ def capture_formats() -> list[str]:
     return sorted(READERS)
 
 
-def read_capture(path: Path) -> tuple[Capture, str]:
-    """Read and validate one capture file; return it with the SHA-256 of its bytes."""
+def read_capture(path: Path, pose: PoseOptions | None = None) -> tuple[Capture, str]:
+    """Read and validate one capture file; return it with the SHA-256 of its bytes.
+
+    ``pose``: how to read keypoint files (`PoseOptions`; ignored for marker files)."""
     path = Path(path)
     if not path.exists():
         raise IngestError(f"{path}: no such file")
@@ -64,5 +72,8 @@ def read_capture(path: Path) -> tuple[Capture, str]:
     data = path.read_bytes()
     if not data.strip():
         raise IngestError(f"{path}: the file is empty")
-    capture = READERS[suffix][1](path, data).validate()
+    if pose_software(path, data) is not None or (pose is not None and pose.software):
+        capture = read_pose(path, data, pose).validate()
+    else:
+        capture = READERS[suffix][1](path, data).validate()
     return capture, hashlib.sha256(data).hexdigest()

@@ -208,5 +208,9 @@ def params_hash(params: Mapping[str, Any]) -> str:
 
 
 def actuated_dimension(params: Mapping[str, Any]) -> int:
-    """m, the number of r_a columns of a version with these parameters."""
+    """m, the number of r_a columns of a version with these parameters (a segment body's
+    description, under ``body``, has one per actuated joint)."""
+    body = params.get("body")
+    if isinstance(body, dict) and body.get("joints"):
+        return sum(j["kind"] == "actuated" for j in body["joints"])
     return 4 if params.get("ra_repr", "angles") == "cartesian" else 2

@@ -21,11 +21,9 @@ import pandas as pd
 import sqlalchemy as sa
 
 from suds_exp.errors import PreprocessError
-from suds_exp.ingest.layout import trial_layout
-from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
-from suds_exp.preprocess.chain import chain_settings
+from suds_exp.preprocess.body_model import BodyModel, SwimmerModel, require_markers
 from suds_exp.preprocess.clean import CleanResult, clean_tracks
-from suds_exp.preprocess.kinematics import Kinematics, Measured, kinematics, measure
+from suds_exp.preprocess.kinematics import Kinematics
 from suds_exp.preprocess.params import params_hash, params_json, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
 from suds_exp.preprocess.rates import Differentiator, smooth, window_frames
@@ -40,9 +38,12 @@ from suds_exp.preprocess.tables import (
 from suds_exp.preprocess.version import load_samples  # noqa: F401  (its old import path)
 from suds_exp.preprocess.version import require_tables as _require_tables
 from suds_exp.progress import progress_bar
-from suds_exp.robot import DRP_COLUMNS, ROLES, RP_COLUMNS
+from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
 from suds_exp.store import Store
 from suds_exp.store.tables import trials
+
+#: A 2-D track (keypoints: z stored NULL where x, y are present) lies in the plane z = 0.
+PLANAR_Z = "CASE WHEN missing THEN z ELSE coalesce(z, 0) END"
 
 #: Trials are written in batches of about this many frames, one transaction each (fewer
 #: transactions are faster; a batch is what an interrupted run may have to redo).
@@ -84,7 +85,7 @@ class _Trial:
     frame: np.ndarray
     t: np.ndarray
     clean: CleanResult
-    measured: Measured
+    measured: Any  # the body model's per-trial geometry (`BodyModel.measure`)
     kin: Kinematics | None = None
 
 
@@ -99,21 +100,24 @@ def _group_key(kind: str, trial_id: int, gait: str | None, frequency_hz: float |
 
 
 # -- reading ------------------------------------------------------------------------------
-def _read_tracks(conn: sa.Connection, meta: pd.DataFrame) -> dict[int, tuple]:
-    """trial id -> (frame (n,), t (n,), xyz (n, 11, 3) in ROLES order, NaN = missing).
+def _read_tracks(conn: sa.Connection, meta: pd.DataFrame, model: BodyModel) -> dict[int, tuple]:
+    """trial id -> (frame (n,), t (n,), xyz (n, n_labels, 3) in the order of
+    ``model.labels``, NaN = missing).
 
-    Trials sharing a marker layout are read in one query that maps marker names to role
+    Trials sharing a marker layout are read in one query that maps marker names to label
     numbers in SQL, so only numbers cross into Python.
     """
     out = {}
+    labels = model.labels
     by_layout: dict[tuple[str, ...], list[int]] = {}
     for tid, stored in zip(meta.id, meta.layout, strict=True):
-        layout = trial_layout(stored if isinstance(stored, str) else None)
-        by_layout.setdefault(tuple(layout[r] for r in ROLES), []).append(int(tid))
+        names = model.marker_names(stored if isinstance(stored, str) else None)
+        by_layout.setdefault(tuple(names), []).append(int(tid))
     for names, ids in by_layout.items():
         df = Store.frame(
             conn,
-            "SELECT trial_id, frame, t, list_position($names, marker) - 1 AS role, x, y, z "
+            "SELECT trial_id, frame, t, list_position($names, marker) - 1 AS role, x, y, "
+            f"{PLANAR_Z} AS z "
             "FROM markers WHERE trial_id IN (SELECT unnest($ids::INTEGER[])) "
             "AND list_contains($names, marker) ORDER BY trial_id, frame, role",
             {"names": list(names), "ids": ids},
@@ -123,25 +127,19 @@ def _read_tracks(conn: sa.Connection, meta: pd.DataFrame) -> dict[int, tuple]:
         for j, tid in enumerate(ids):
             part = df.iloc[bounds[j] : bounds[j + 1]]
             role = part.role.to_numpy()
-            present = np.unique(role)
-            if len(present) < len(ROLES):
-                lacking = [ROLES[i] for i in range(len(ROLES)) if i not in set(present)]
-                raise PreprocessError(
-                    f"trial {tid}: has no marker for role(s) {', '.join(lacking)}; "
-                    "re-ingest it with a layout naming them"
-                )
+            require_markers(model, tid, np.unique(role))
             values = part[["x", "y", "z"]].to_numpy(dtype=float)
             frame_col = part.frame.to_numpy()
-            n = len(part) // len(ROLES)
-            if len(part) == n * len(ROLES) and np.array_equal(
-                role, np.tile(np.arange(len(ROLES)), n)
+            n = len(part) // len(labels)
+            if len(part) == n * len(labels) and np.array_equal(
+                role, np.tile(np.arange(len(labels)), n)
             ):
-                xyz = values.reshape(n, len(ROLES), 3)
-                frames = frame_col[:: len(ROLES)]
-                t = part.t.to_numpy()[:: len(ROLES)]
+                xyz = values.reshape(n, len(labels), 3)
+                frames = frame_col[:: len(labels)]
+                t = part.t.to_numpy()[:: len(labels)]
             else:  # a frame lacks some marker rows: scatter
                 frames, inverse = np.unique(frame_col, return_inverse=True)
-                xyz = np.full((len(frames), len(ROLES), 3), np.nan)
+                xyz = np.full((len(frames), len(labels), 3), np.nan)
                 xyz[inverse, role] = values
                 t = np.zeros(len(frames))
                 t[inverse] = part.t.to_numpy()
@@ -173,7 +171,7 @@ def _trial_meta(conn: sa.Connection, trial_ids: Iterable[int] | None) -> pd.Data
 
 
 # -- per-trial computation ------------------------------------------------------------------
-def _prepare(meta_row, tracks, params: dict) -> _Trial:
+def _prepare(meta_row, tracks, params: dict, model: BodyModel) -> _Trial:
     tid = int(meta_row.id)
     label = f"trial {tid} ({meta_row.source_file})"
     frame, t, xyz = tracks
@@ -182,23 +180,14 @@ def _prepare(meta_row, tracks, params: dict) -> _Trial:
         raise PreprocessError(f"{label}: only {len(frame)} frames; need at least 8")
     max_gap = int(np.floor(params["max_gap_s"] * rate + 1e-9))
     try:
-        cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in ROLES])
-        measured = measure(cleaned.xyz, params["tail_fit"])
+        cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in model.labels])
+        measured = model.measure(cleaned.xyz, params)
     except PreprocessError as exc:
         raise PreprocessError(f"{label}: {exc}", param=exc.param) from None
     gait = meta_row.gait if isinstance(meta_row.gait, str) else None
     freq = None if pd.isna(meta_row.frequency_hz) else float(meta_row.frequency_hz)
     group = _group_key(params["phaser_group"], tid, gait, freq)
     return _Trial(tid, label, group, rate, freq, frame, t, cleaned, measured)
-
-
-def _concat_frames(items: list[_Trial]) -> SegmentFrames:
-    return SegmentFrames(
-        *[
-            np.concatenate([getattr(tr.measured.frames, a) for tr in items])
-            for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
-        ]
-    )
 
 
 #: Phaser channel order of the Cartesian r_a (head x, head y, tail x, tail y): the y values
@@ -254,11 +243,9 @@ def _samples_frame(tr: _Trial, version_id: int, pca: PassivePCA, phaser: Phaser,
     return pd.DataFrame(cols)
 
 
-def _stats_row(tr: _Trial, version_id: int, joints: Joints) -> dict:
+def _stats_row(tr: _Trial, version_id: int, joints: Any, model: BodyModel) -> dict:
     c = tr.clean
-    head, tail = joints.points(tr.measured.frames)
-    # this trial's distance between the segment origins (constant if the fit holds here)
-    dist = np.hypot(*(head - tail).T)
+    normal, length, rms = model.stats(tr.measured, joints)
     return {
         "version_id": version_id,
         "trial_id": tr.id,
@@ -267,28 +254,12 @@ def _stats_row(tr: _Trial, version_id: int, joints: Joints) -> dict:
         "removed_fraction": c.removed_fraction,
         "filled_fraction": c.filled_fraction,
         "longest_gap_frames": c.longest_gap,
-        "plane_normal": tr.measured.plane.basis[2].tolist(),
-        "middle_length_mm": float(dist.mean()),
-        "joint_rms_mm": float(dist.std()),
+        "plane_normal": normal,
+        "middle_length_mm": length,
+        "joint_rms_mm": rms,
         "phaser_group": tr.group,
         "done_at": pd.Timestamp.now(tz="UTC").tz_localize(None),
     }
-
-
-def _joints_state(j: Joints) -> str:
-    return json.dumps(
-        {
-            "head": j.head.tolist(),
-            "tail": j.tail.tolist(),
-            "length_mm": j.length_mm,
-            "rms_mm": j.rms_mm,
-        }
-    )
-
-
-def _joints_from(state: str) -> Joints:
-    d = json.loads(state)
-    return Joints(np.asarray(d["head"]), np.asarray(d["tail"]), d["length_mm"], d["rms_mm"])
 
 
 # -- the run ------------------------------------------------------------------------------
@@ -297,7 +268,7 @@ class Fitted:
     """What a version holds for its trials: segment origins by trial id, the passive PCA,
     one Phaser per trial group, and the fits this run made (`NewFit`, not yet stored)."""
 
-    joints: dict[int, Joints]
+    joints: dict[int, Any]
     pca: PassivePCA
     phasers: dict[str, Phaser]
     new: list[NewFit] = field(default_factory=list)
@@ -322,6 +293,7 @@ def preprocess(
     trials: Iterable[int] | None = None,
     progress: bool = True,
     preset: str | None = None,
+    body: BodyModel | None = None,
 ) -> PrepResult:
     """Create or reuse the preprocessing version of ``params`` and fill its samples.
 
@@ -340,6 +312,9 @@ def preprocess(
     preset : str, optional
         A named parameter set (`suds_exp.preprocess.params.PRESETS`: ``default``,
         ``paper``) under ``params``.
+    body : BodyModel, optional
+        The body's geometry (`suds_exp.preprocess.body_model`; `suds_exp.body` makes one
+        from a description of rigid segments); default the paper's swimmer.
 
     Returns
     -------
@@ -349,25 +324,26 @@ def preprocess(
     gap longer than ``max_gap_s``; `ConfigError` for a bad parameter.
     """
     started = time.perf_counter()
-    params = resolve_params(params, preset)
+    model = SwimmerModel() if body is None else body
+    params = model.version_params(resolve_params(params, preset))
     digest = params_hash(params)
     with store.write() as conn:
         row = find_version(conn, name, digest)
         meta = _trial_meta(conn, trials)
         done, fits = stored_progress(conn, None if row is None else row.id)
         todo = meta[~meta.id.isin(done)]
-        tracks = _read_tracks(conn, todo) if len(todo) else {}
+        tracks = _read_tracks(conn, todo, model) if len(todo) else {}
     if meta.empty:
         raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
     result = new_result(row, name, params, digest, skipped=meta.id[meta.id.isin(done)])
-    items = clean(todo, tracks, params, progress)
+    items = clean(todo, tracks, params, progress, model)
     if not items:
         result.explained_variance_ratio = _kept_ratio(store, result.version_id, params["k"])
         result.seconds = time.perf_counter() - started
         return result
-    fitted = fit(items, params, fits)
+    fitted = fit(items, params, fits, model)
     write_version(store, result, fitted.new, fitted.pca, params["k"])
-    write_samples(store, result, items, fitted, params, progress)
+    write_samples(store, result, items, fitted, params, progress, model)
     result.explained_variance_ratio = fitted.pca.explained_variance_ratio_[: params["k"]].tolist()
     result.seconds = time.perf_counter() - started
     return result
@@ -401,35 +377,47 @@ def new_result(row, name: str | None, params: dict, digest: str, skipped) -> Pre
     )
 
 
-def clean(todo: pd.DataFrame, tracks: dict[int, tuple], params: dict, progress: bool):
+def clean(
+    todo: pd.DataFrame,
+    tracks: dict[int, tuple],
+    params: dict,
+    progress: bool,
+    model: BodyModel | None = None,
+):
     """Clean and measure every trial of ``todo`` (rows of `_trial_meta`, their tracks from
     `_read_tracks`); any refusal raises `PreprocessError` before anything is written."""
+    model = SwimmerModel() if model is None else model
     items: list[_Trial] = []
     with progress_bar(
         "Cleaning", total=len(todo), enabled=progress and bool(len(todo)), unit="trials"
     ) as advance:
         for meta_row in todo.itertuples(index=False):
-            items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params))
+            items.append(_prepare(meta_row, tracks.pop(int(meta_row.id)), params, model))
             advance()
     return items
 
 
-def fit(items: list[_Trial], params: dict, fits: dict[tuple[str, str], str]) -> Fitted:
+def fit(
+    items: list[_Trial],
+    params: dict,
+    fits: dict[tuple[str, str], str],
+    model: BodyModel | None = None,
+) -> Fitted:
     """Fit what the version lacks (``fits``: its stored states by (kind, group)) on the
     trials of this run, and set each trial's kinematics."""
+    model = SwimmerModel() if model is None else model
     new: list[NewFit] = []
     if params["joint_fit"] == "version":
         if ("joints", "") in fits:
-            shared = _joints_from(fits[("joints", "")])
+            shared = model.joints_from(fits[("joints", "")])
         else:
-            shared = fit_joints(_concat_frames(items))
-            new.append(_new_fit("joints", "", _joints_state(shared), items))
+            shared = model.fit_joints([tr.measured for tr in items])
+            new.append(_new_fit("joints", "", model.joints_state(shared), items))
         joints = {tr.id: shared for tr in items}
     else:
-        joints = {tr.id: fit_joints(tr.measured.frames) for tr in items}
+        joints = {tr.id: model.fit_joints([tr.measured]) for tr in items}
     for tr in items:
-        chain = chain_settings(params, tr.rate_hz, tr.frequency_hz, len(tr.t))
-        tr.kin = kinematics(tr.measured, joints[tr.id], chain, params["ra_repr"])
+        tr.kin = model.kinematics(tr.measured, joints[tr.id], params, tr.rate_hz, tr.frequency_hz)
     # the passive reducer (PCA, kernel PCA or autoencoder: suds_exp.preprocess.reduction)
     pca, fitted = passive_reducer(
         params, fits, lambda: np.concatenate([_smoothed(tr, params)[1] for tr in items])
@@ -490,10 +478,12 @@ def write_samples(
     fitted: Fitted,
     params: dict,
     progress: bool,
+    model: BodyModel | None = None,
 ) -> None:
     """Phase, rates and samples of every trial, with its stats; each batch of about
     `WRITE_BATCH_FRAMES` frames in one transaction, recorded in ``result`` once written."""
     vid = result.version_id
+    model = SwimmerModel() if model is None else model
     with progress_bar(
         "Preprocessing", total=len(items), enabled=progress, unit="trials"
     ) as advance:
@@ -505,7 +495,9 @@ def write_samples(
                     _samples_frame(b, vid, fitted.pca, fitted.phasers[b.group], params)
                     for b in batch
                 ]
-                stats = pd.DataFrame([_stats_row(b, vid, fitted.joints[b.id]) for b in batch])
+                stats = pd.DataFrame(
+                    [_stats_row(b, vid, fitted.joints[b.id], model) for b in batch]
+                )
                 write_trials(store, result, pd.concat(frames, ignore_index=True), stats)
                 advance(len(batch))
                 batch = []

@@ -69,9 +69,9 @@ samples = sa.Table(
     sa.Column("phase", sa.Float, nullable=False),
     sa.Column("cycle", sa.Integer, nullable=False),
     sa.Column("ra_1", sa.Float, nullable=False),
-    sa.Column("ra_2", sa.Float, nullable=False),
+    sa.Column("ra_2", sa.Float),
     sa.Column("dra_1", sa.Float, nullable=False),
-    sa.Column("dra_2", sa.Float, nullable=False),
+    sa.Column("dra_2", sa.Float),
     *(sa.Column(c, sa.Float) for c in RP_COLUMNS),
     *(sa.Column(c, sa.Float) for c in DRP_COLUMNS),
     sa.Column("vx", sa.Float, nullable=False),
@@ -79,4 +79,6 @@ samples = sa.Table(
     sa.Column("wz", sa.Float, nullable=False),
     # migration 011: the Cartesian r_a's last two values (NULL for joint angles)
     *(sa.Column(c, sa.Float) for c in ("ra_3", "ra_4", "dra_3", "dra_4")),
+    # migration 018: up to 8 actuated joints of a segment body (ra_2, dra_2 may be NULL)
+    *(sa.Column(f"{p}_{i}", sa.Float) for i in range(5, 9) for p in ("ra", "dra")),
 )

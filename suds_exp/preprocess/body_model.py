@@ -1,0 +1,141 @@
+"""The body hook of `preprocess`: what is specific to a body's geometry, behind one face.
+
+`preprocess` reads markers, cleans them, fits what a version shares, and turns each
+trial's body pose, actuated shape and passive state into samples (smoothing, passive PCA,
+phase, rates, body velocity). Only the middle of that depends on the body: which markers
+to read, how the cleaned markers become segment frames, what a version fits across trials
+(the joint positions) and how frames and joints give the pose and shape. A `BodyModel`
+does exactly that; `SwimmerModel` is the paper's swimmer (the pipeline's default), and
+`suds_exp.body` builds one from any description of rigid segments.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from suds_exp.errors import PreprocessError
+from suds_exp.ingest.layout import trial_layout
+from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
+from suds_exp.preprocess.chain import chain_settings
+from suds_exp.preprocess.kinematics import Kinematics, kinematics, measure
+from suds_exp.robot import ROLES
+
+
+class BodyModel:
+    """The body-specific steps of `preprocess` (override every method).
+
+    ``labels``: the names of the markers a trial is read as, in the order of the tracks
+    the other methods receive (n_frames, len(labels), 3).
+    """
+
+    labels: tuple[str, ...] = ()
+
+    def version_params(self, params: dict[str, Any]) -> dict[str, Any]:
+        """The version's full parameters given the resolved ones (add what names the body,
+        refuse what it cannot honour)."""
+        return params
+
+    def marker_names(self, layout: str | None) -> list[str]:
+        """The trial's marker names of `labels`, in order (``layout``: its stored layout)."""
+        raise NotImplementedError
+
+    def missing(self, trial_id: int, lacking: Sequence[str]) -> str:
+        """The one-line message for a trial lacking markers of these labels."""
+        return f"trial {trial_id}: has no marker {', '.join(lacking)}"
+
+    def measure(self, xyz: np.ndarray, params: dict[str, Any]) -> Any:
+        """Per-trial geometry from cleaned tracks (n_frames, len(labels), 3) mm."""
+        raise NotImplementedError
+
+    def fit_joints(self, measured: Sequence[Any]) -> Any:
+        """What the version shares, fitted on the measured trials (the joint positions)."""
+        raise NotImplementedError
+
+    def joints_state(self, joints: Any) -> str:
+        raise NotImplementedError
+
+    def joints_from(self, state: str) -> Any:
+        raise NotImplementedError
+
+    def kinematics(
+        self,
+        measured: Any,
+        joints: Any,
+        params: dict[str, Any],
+        rate_hz: float,
+        frequency_hz: float | None,
+    ) -> Kinematics:
+        """Body pose, r_a and passive state of one trial."""
+        raise NotImplementedError
+
+    def stats(self, measured: Any, joints: Any) -> tuple[list[float], float, float]:
+        """(plane normal (3,), mean and RMS deviation of the checked joint distance, mm)
+        for the trial's `prep_trials` row."""
+        raise NotImplementedError
+
+
+class SwimmerModel(BodyModel):
+    """The paper's swimmer: 11 markers by role (a trial's layout names them), head and tail
+    frames from their top markers (the tail's refined by ``tail_fit``), motor axes at a
+    constant distance (`fit_joints`), body pose from the segment frames or the chain fit."""
+
+    labels = ROLES
+
+    def marker_names(self, layout: str | None) -> list[str]:
+        names = trial_layout(layout)
+        return [names[r] for r in ROLES]
+
+    def missing(self, trial_id: int, lacking: Sequence[str]) -> str:
+        return (
+            f"trial {trial_id}: has no marker for role(s) {', '.join(lacking)}; "
+            "re-ingest it with a layout naming them"
+        )
+
+    def measure(self, xyz: np.ndarray, params: dict[str, Any]):
+        return measure(xyz, params["tail_fit"])
+
+    def fit_joints(self, measured: Sequence[Any]) -> Joints:
+        return fit_joints(
+            SegmentFrames(
+                *[
+                    np.concatenate([getattr(m.frames, a) for m in measured])
+                    for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
+                ]
+            )
+        )
+
+    def joints_state(self, joints: Joints) -> str:
+        return json.dumps(
+            {
+                "head": joints.head.tolist(),
+                "tail": joints.tail.tolist(),
+                "length_mm": joints.length_mm,
+                "rms_mm": joints.rms_mm,
+            }
+        )
+
+    def joints_from(self, state: str) -> Joints:
+        d = json.loads(state)
+        return Joints(np.asarray(d["head"]), np.asarray(d["tail"]), d["length_mm"], d["rms_mm"])
+
+    def kinematics(self, measured, joints, params, rate_hz, frequency_hz) -> Kinematics:
+        chain = chain_settings(params, rate_hz, frequency_hz, len(measured.local))
+        return kinematics(measured, joints, chain, params["ra_repr"])
+
+    def stats(self, measured, joints: Joints) -> tuple[list[float], float, float]:
+        head, tail = joints.points(measured.frames)
+        # this trial's distance between the segment origins (constant if the fit holds here)
+        dist = np.hypot(*(head - tail).T)
+        return measured.plane.basis[2].tolist(), float(dist.mean()), float(dist.std())
+
+
+def require_markers(model: BodyModel, trial_id: int, present: np.ndarray) -> None:
+    """Raise `PreprocessError` unless label numbers ``present`` cover every label."""
+    have = set(int(i) for i in present)
+    lacking = [model.labels[i] for i in range(len(model.labels)) if i not in have]
+    if lacking:
+        raise PreprocessError(model.missing(trial_id, lacking))
