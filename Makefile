@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow browser lint lint-imports clean
+.PHONY: demo test test-slow browser lint lint-imports wheel-check clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -35,6 +35,11 @@ lint: $(STAMP)
 # the layering contracts in pyproject.toml ([tool.importlinter])
 lint-imports: $(STAMP)
 	$(BIN)/lint-imports
+
+# build the sdist and wheel, install the wheel in a fresh venv outside the checkout and run
+# a short quickstart from an empty folder (.ci/wheel_check.sh; run by .ci/run)
+wheel-check: $(STAMP)
+	PY=$(PY) bash .ci/wheel_check.sh
 
 clean:
 	rm -rf $(VENV) *.duckdb reports/*/ sim-data
