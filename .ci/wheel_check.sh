@@ -21,6 +21,23 @@ SDIST=$(ls "$WORK"/dist/suds_exp-*.tar.gz)
 WHEEL=$(ls "$WORK"/dist/suds_exp-*.whl)
 ls -l "$SDIST" "$WHEEL"
 
+step "what the wheel and the sdist hold"
+"$PY" - "$REPO" "$SDIST" "$WHEEL" <<'EOF'
+import sys, tarfile, zipfile
+from pathlib import Path
+repo, sdist, wheel = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+sql = sorted(p.name for p in (repo / "migrations").glob("*.sql"))
+in_wheel = zipfile.ZipFile(wheel).namelist()
+in_sdist = tarfile.open(sdist).getnames()
+for name in sql:
+    assert f"suds_exp/migrations/{name}" in in_wheel, f"wheel lacks migration {name}"
+    assert any(n.endswith(f"/migrations/{name}") for n in in_sdist), f"sdist lacks {name}"
+for data in ("suds_exp/body/swimmer.toml", "suds_exp/__main__.py", "cli.py"):
+    assert data in in_wheel, f"wheel lacks {data}"
+assert any(n.endswith(".dist-info/licenses/LICENSE") for n in in_wheel), "wheel lacks LICENSE"
+print(f"wheel: {len(in_wheel)} files, {len(sql)} migrations, swimmer.toml, LICENSE; sdist too")
+EOF
+
 step "install the wheel into a fresh venv"
 "$PY" -m venv "$WORK/venv"
 # --no-compile: byte-compile only what the quickstart imports, not every dependency
@@ -36,27 +53,12 @@ cd "$WORK/run"
 unset PYTHONPATH SUDS_DB SUDS_MIGRATIONS
 export PATH="$BIN:$PATH"
 
-step "what the wheel and the sdist hold"
-python - "$REPO" "$SDIST" "$WHEEL" <<'EOF'
-import sys, tarfile, zipfile
-from pathlib import Path
-repo, sdist, wheel = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
-sql = sorted(p.name for p in (repo / "migrations").glob("*.sql"))
-in_wheel = zipfile.ZipFile(wheel).namelist()
-in_sdist = tarfile.open(sdist).getnames()
-for name in sql:
-    assert f"suds_exp/migrations/{name}" in in_wheel, f"wheel lacks migration {name}"
-    assert any(n.endswith(f"/migrations/{name}") for n in in_sdist), f"sdist lacks {name}"
-for data in ("suds_exp/body/swimmer.toml", "suds_exp/__main__.py", "cli.py"):
-    assert data in in_wheel, f"wheel lacks {data}"
-assert any(n.endswith(".dist-info/licenses/LICENSE") for n in in_wheel), "wheel lacks LICENSE"
-print(f"wheel: {len(in_wheel)} files, {len(sql)} migrations, swimmer.toml, LICENSE; sdist too")
-EOF
+step "the installed package is the one imported"
 python - <<'EOF'
-import cli, suds_exp
+import sys, cli, suds_exp
 from importlib.resources import files
 for module in (suds_exp, cli):
-    assert "/venv/" in module.__file__, f"{module.__name__} imported from {module.__file__}"
+    assert module.__file__.startswith(sys.prefix), f"{module.__name__} from {module.__file__}"
 print("imported from", suds_exp.__file__, "; migrations at", files("suds_exp.migrations"))
 EOF
 
