@@ -6,16 +6,16 @@ The same checks run on a built wheel installed outside the checkout in .ci/wheel
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import json
 import re
 import subprocess
 import sys
 import tomllib
-from importlib.metadata import version
+from importlib.metadata import packages_distributions, version
 from pathlib import Path
 
-import pytest
 from typer.testing import CliRunner
 
 import suds_exp
@@ -137,9 +137,50 @@ def test_missing_migrations_package_refuses_an_existing_database_untouched(db, m
     assert digest(db) == before
 
 
-@pytest.mark.parametrize("builtin", ["swimmer"])
-def test_builtin_body_descriptions_are_package_data(builtin):
+def test_builtin_body_descriptions_are_package_data():
     from suds_exp.body.description import BUILTIN, load_body
 
-    assert builtin in BUILTIN
-    assert load_body(builtin).name == builtin
+    for name in BUILTIN:
+        assert load_body(name).name == name
+
+
+def imported_modules(top_level_only: bool) -> set[str]:
+    """Top-level names of the third-party modules that suds_exp/ and cli.py import
+    (``top_level_only``: at module level, not inside a function)."""
+    found = set()
+    for path in [REPO / "cli.py", *(REPO / "suds_exp").rglob("*.py")]:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        nodes = tree.body if top_level_only else ast.walk(tree)
+        for node in nodes:
+            if isinstance(node, ast.Import):
+                found |= {a.name.split(".")[0] for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                found.add(node.module.split(".")[0])
+    return found - set(sys.stdlib_module_names) - {"suds_exp", "cli", "__future__"}
+
+
+def distribution_names(requirements: list[str]) -> set[str]:
+    return {re.sub(r"[-_.]+", "-", re.match(r"[\w.-]+", r).group()).lower() for r in requirements}
+
+
+def test_every_imported_module_is_a_declared_dependency():
+    project = pyproject()["project"]
+    required = distribution_names(project["dependencies"])
+    extras = distribution_names(
+        [
+            r
+            for name, reqs in project["optional-dependencies"].items()
+            if name != "dev"
+            for r in reqs
+        ]
+    )
+    of_module = packages_distributions()
+
+    def dists(module: str) -> set[str]:
+        return {re.sub(r"[-_.]+", "-", d).lower() for d in of_module.get(module, [])}
+
+    for module in imported_modules(top_level_only=True):
+        assert dists(module) & required, f"{module} is imported but not in dependencies"
+    # a module imported only where it is used (dask) may be an optional extra instead
+    for module in imported_modules(top_level_only=False):
+        assert dists(module) & (required | extras), f"{module} is imported but not declared"
