@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-slow browser lint lint-imports docs clean
+.PHONY: demo test test-slow browser lint lint-imports docs wheel-check clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
@@ -44,6 +44,11 @@ $(DOCS_STAMP): $(STAMP)
 
 docs: $(DOCS_STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
+# build the sdist and wheel, install the wheel in a fresh venv outside the checkout and run
+# a short quickstart from an empty folder (.ci/wheel_check.sh; run by .ci/run)
+wheel-check: $(STAMP)
+	PY=$(PY) bash .ci/wheel_check.sh
 
 clean:
 	rm -rf $(VENV) *.duckdb reports/*/ sim-data site

@@ -14,7 +14,7 @@ from typing import Annotated
 
 import typer
 
-from suds_exp import console
+from suds_exp import __version__, console
 from suds_exp.errors import SudsError
 from suds_exp.store import Store, default_db_path
 
@@ -85,6 +85,25 @@ def command(*args, flags: dict[str, str] | None = None, **kwargs):
         return app.command(*args, **kwargs)(run)
 
     return wrap
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        console.out.print(f"suds-exp {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_print_version, is_eager=True, help="Print the version and exit."
+        ),
+    ] = False,
+) -> None:
+    # the options of `suds-exp` itself, before any command; the help text is the app's
+    pass
 
 
 def open_store(db: Path | None) -> Store:

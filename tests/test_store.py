@@ -69,7 +69,7 @@ def test_database_at_migration_1_upgrades_with_data_intact(db, make_qtm):
 
 def test_edited_migration_is_refused(db, tmp_path):
     folder = tmp_path / "migrations"
-    shutil.copytree(migrate.MIGRATIONS_DIR, folder)
+    shutil.copytree(Path(str(migrate.migrations_dir())), folder)
     engine = make_engine(db)
     try:
         migrate.upgrade(engine, directory=folder)

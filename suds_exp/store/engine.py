@@ -41,7 +41,9 @@ def make_engine(path: Path, read_only: bool = False) -> sa.Engine:
     connect_args: dict = {"read_only": read_only}
     if not read_only:
         connect_args["config"] = {"storage_compatibility_version": STORAGE_VERSION}
-    return sa.create_engine(f"duckdb:///{path}", poolclass=NullPool, connect_args=connect_args)
+    # the dialect named in full: a venv that still has duckdb-engine registers "duckdb" too
+    url = f"duckdb+duckdb_sqlalchemy:///{path}"
+    return sa.create_engine(url, poolclass=NullPool, connect_args=connect_args)
 
 
 def is_lock_error(exc: BaseException) -> bool:

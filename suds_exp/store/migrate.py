@@ -4,6 +4,12 @@ Files in ``migrations/`` are named ``NNN_description.sql``. The runner records e
 applied file's version, name and SHA-256 in ``schema_migrations``; a file whose text
 changed after it was applied is refused, because the database it describes no longer
 matches the code.
+
+The files are package data: the repository's top-level ``migrations/`` folder is the
+package ``suds_exp.migrations`` once installed (pyproject.toml maps it), read through
+``importlib.resources`` so a wheel finds them wherever it is installed. Finding none is
+an error, never an empty schema: a database "migrated" by nothing would hold only
+``schema_migrations`` and fail later, far from the cause.
 """
 
 from __future__ import annotations
@@ -12,6 +18,8 @@ import hashlib
 import os
 import re
 from dataclasses import dataclass
+from importlib import resources
+from importlib.resources.abc import Traversable
 from pathlib import Path
 
 import duckdb
@@ -19,9 +27,8 @@ import sqlalchemy as sa
 
 from suds_exp.errors import StoreError
 
-MIGRATIONS_DIR = Path(
-    os.environ.get("SUDS_MIGRATIONS") or Path(__file__).resolve().parents[2] / "migrations"
-)
+#: The package whose data files are the migrations (the repository's ``migrations/``).
+MIGRATIONS_PACKAGE = "suds_exp.migrations"
 _NAME = re.compile(r"^(\d{3})_([a-z0-9_]+)\.sql$")
 
 _BOOKKEEPING = """
@@ -44,16 +51,45 @@ class Migration:
     checksum: str
 
 
-def available_migrations(directory: Path = MIGRATIONS_DIR) -> list[Migration]:
-    """The migration files in ``directory``, ordered by version."""
+def migrations_dir() -> Traversable:
+    """Where the migration files are: the folder ``$SUDS_MIGRATIONS`` when set, else the
+    installed package data `MIGRATIONS_PACKAGE`."""
+    override = os.environ.get("SUDS_MIGRATIONS")
+    if override:
+        return Path(override)
+    try:
+        return resources.files(MIGRATIONS_PACKAGE)
+    except ModuleNotFoundError:
+        raise StoreError(
+            f"no migrations found: the package data {MIGRATIONS_PACKAGE} is not installed; "
+            "reinstall suds-exp"
+        ) from None
+
+
+def available_migrations(directory: Path | Traversable | None = None) -> list[Migration]:
+    """The migration files in ``directory`` (`migrations_dir` when None), ordered by
+    version; refuses a folder that holds none."""
+    directory = migrations_dir() if directory is None else directory
+    try:
+        paths = sorted(
+            (p for p in directory.iterdir() if p.name.endswith(".sql")), key=lambda p: p.name
+        )
+    except OSError:  # no such folder, or not a folder
+        paths = []
+    if not paths:
+        raise StoreError(
+            f"no migrations found in {directory}: the installation is incomplete; "
+            "reinstall suds-exp (the database was not touched)"
+        )
     found = []
-    for path in sorted(directory.glob("*.sql")):
+    for path in paths:
         m = _NAME.match(path.name)
         if not m:
             raise StoreError(f"{path}: migration files must be named NNN_name.sql")
         text = path.read_text(encoding="utf-8")
+        name = path.name.removesuffix(".sql")
         found.append(
-            Migration(int(m.group(1)), path.stem, text, hashlib.sha256(text.encode()).hexdigest())
+            Migration(int(m.group(1)), name, text, hashlib.sha256(text.encode()).hexdigest())
         )
     versions = [m.version for m in found]
     if len(set(versions)) != len(versions):
@@ -87,12 +123,17 @@ def pending(conn: sa.Connection, migrations: list[Migration]) -> list[Migration]
 
 
 def upgrade(
-    engine: sa.Engine, target: int | None = None, directory: Path = MIGRATIONS_DIR
+    engine: sa.Engine, target: int | None = None, directory: Path | Traversable | None = None
 ) -> list[str]:
-    """Apply pending migrations up to ``target`` (all when None); return their names."""
-    migrations = [
-        m for m in available_migrations(directory) if target is None or m.version <= target
-    ]
+    """Apply pending migrations up to ``target`` (all when None) from ``directory``
+    (`migrations_dir` when None); return their names."""
+    return apply(engine, available_migrations(directory), target)
+
+
+def apply(engine: sa.Engine, migrations: list[Migration], target: int | None = None) -> list[str]:
+    """Apply those of ``migrations`` not yet in the database, up to version ``target``
+    (all when None), each in its own transaction; return their names."""
+    migrations = [m for m in migrations if target is None or m.version <= target]
     with engine.begin() as conn:
         todo = pending(conn, migrations)
     applied = []

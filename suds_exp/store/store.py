@@ -41,14 +41,18 @@ class Store:
 
     # -- connections ---------------------------------------------------------------
     def upgrade(self, target: int | None = None) -> list[str]:
-        """Create the file if needed and apply pending migrations; return their names."""
+        """Create the file if needed and apply pending migrations; return their names.
+
+        Refuses (`StoreError`) before the file or its folder is touched when no migration
+        files are installed."""
+        migrations = migrate.available_migrations()
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise open_problem(exc, self.path) from None
         engine = make_engine(self.path)
         try:
-            applied = retry_on_lock(lambda: migrate.upgrade(engine, target), self.path)
+            applied = retry_on_lock(lambda: migrate.apply(engine, migrations, target), self.path)
         finally:
             engine.dispose()
         if target is None:
@@ -79,6 +83,9 @@ class Store:
         """A read-only connection; refuses a file that does not exist."""
         if not self.path.exists():
             raise StoreError(f"{self.path}: no database here; create one with `suds-exp init`")
+        # an installation without its migrations is broken for reading too: refuse it in
+        # one line here rather than let a later write fail far from the cause
+        migrate.available_migrations()
         with self._connect(read_only=True) as conn:
             yield conn
 
