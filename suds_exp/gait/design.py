@@ -77,7 +77,7 @@ class DesignOptions:
     grow: float = 1.5
     shrink: float = 0.5
     accept_error: float = 0.2
-    max_evals: int = 800
+    max_evals: int = 400
     cycles: int = 10
 
     def check(self) -> None:

@@ -1,8 +1,9 @@
 """Predict what a gait does from a learned motility map.
 
 The learner is fitted on a preprocessing version's trials (decimated to the same samples
-per cycle at every frequency, as the campaign does), rolled over the gait and the body's
-path reconstructed by the path-ordered SE(2) integral (`suds_exp.gait.motion`):
+per cycle at every frequency by the campaign's rule: the fewest of any trial), rolled over
+the gait and the body's path reconstructed by the path-ordered SE(2) integral
+(`suds_exp.gait.motion`):
 
 - phase-free learners (GMR) see only (r_a, dr_a/dt) of the gait;
 - phase-based learners (phase-only, TLS) get the gait's own phase as ``phase``;
@@ -35,8 +36,8 @@ from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
 #: Cycles rolled and the cycles (0-based) averaged.
 N_CYCLES = 4
 MEASURED = (2, 3)
-#: Samples per cycle of the training data (decimated) and of the rolled gait.
-SAMPLES_PER_CYCLE = 50
+#: Samples per cycle of the rolled gait (and of training data whose rate is unknown).
+SAMPLES_PER_CYCLE = 100
 MOTION_KEYS = ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s")
 
 
@@ -46,19 +47,26 @@ def derive_seed(*key) -> int:
     return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "little")
 
 
-def decimate(samples: pd.DataFrame, samples_per_cycle: int = SAMPLES_PER_CYCLE) -> pd.DataFrame:
+def _raw_samples_per_cycle(trial: pd.DataFrame) -> float:
+    dt = float(np.median(np.diff(trial["t"].to_numpy()))) if len(trial) > 1 else np.nan
+    f = float(trial["frequency_hz"].iloc[0]) if "frequency_hz" in trial else np.nan
+    return 1 / (f * dt) if np.isfinite(f) and f > 0 and dt > 0 else np.nan
+
+
+def decimate(samples: pd.DataFrame, samples_per_cycle: int | None = None) -> pd.DataFrame:
     """Every trial's samples thinned to about ``samples_per_cycle`` per cycle (plain
-    decimation by a whole factor from its frequency and sample spacing)."""
-    parts = []
-    for _, trial in samples.groupby("trial_id", sort=True):
-        dt = float(np.median(np.diff(trial["t"].to_numpy()))) if len(trial) > 1 else 1.0
-        f = trial["frequency_hz"].iloc[0] if "frequency_hz" in trial else np.nan
-        step = (
-            1
-            if not np.isfinite(f) or f <= 0
-            else max(1, int(round(1 / f / dt / samples_per_cycle)))
-        )
-        parts.append(trial.iloc[::step])
+    decimation by a whole factor from its frequency and sample spacing). None: the
+    campaign's rule (`suds_exp.campaign.bank`), the fewest samples per cycle of any
+    trial, so every frequency ends with the same."""
+    trials = [t for _, t in samples.groupby("trial_id", sort=True)]
+    raw = [_raw_samples_per_cycle(t) for t in trials]
+    if samples_per_cycle is None:
+        finite = [r for r in raw if np.isfinite(r)]
+        samples_per_cycle = int(round(min(finite))) if finite else SAMPLES_PER_CYCLE
+    parts = [
+        t.iloc[:: max(1, int(round(r / samples_per_cycle))) if np.isfinite(r) else 1]
+        for t, r in zip(trials, raw, strict=True)
+    ]
     return pd.concat(parts) if parts else samples
 
 
@@ -147,9 +155,10 @@ def fit_map(
     samples: pd.DataFrame,
     learner: str = "GMR",
     params: dict | None = None,
-    samples_per_cycle: int = SAMPLES_PER_CYCLE,
+    samples_per_cycle: int | None = None,
 ) -> FittedMap:
-    """Fit ``learner`` on ``samples`` (the version's frame; decimated here)."""
+    """Fit ``learner`` on ``samples`` (the version's frame; decimated here as a campaign
+    does, see `decimate`)."""
     train = decimate(samples, samples_per_cycle)
     k = sum(1 for c in RP_COLUMNS if c in train.columns)
     rp0 = train[list(RP_COLUMNS[:k])].mean().to_numpy(float) if k else np.zeros(0)
