@@ -8,7 +8,9 @@ the paper's annulus of shapes in other directions. Ingests and preprocesses all,
 GMR on the paper's five gaits alone and on all gaits, and prints the normalised RMS
 difference of the learned connection from `suds-exp connection`'s (least squares over 8
 directions, flippers locked) inside the support (shapes within 0.1 rad of a training
-shape), per row of A and their mean. Draws both (--out).
+shape), per row of A and their mean, and how far the learned map itself is from the
+simulator's quasi-static body velocity at the training samples' own shapes and directions
+of shape velocity. Draws both (--out).
 
 Why the extra gaits: the paper's five gaits all circle the origin in one sense, so at any
 shape the data hold one direction of shape velocity (the five cross at shallow angles);
@@ -37,6 +39,7 @@ from suds_exp.gait.trials import simulate_gait_file  # noqa: E402
 from suds_exp.ingest import ingest_paths  # noqa: E402
 from suds_exp.preprocess import get_version, preprocess  # noqa: E402
 from suds_exp.sim import SimConfig, local_connection, set_effect, simulate_dataset  # noqa: E402
+from suds_exp.sim.connection import body_twists, robot_config  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 
@@ -53,6 +56,23 @@ def extra_gaits() -> list:
         ellipse(1.1, 1.1, 0.6, name="ellipse+0.6.toml"),
         ellipse(1.1, 1.1, -0.6, name="ellipse-0.6.toml"),
     ]
+
+
+def at_data_directions(model, samples, n: int = 2000, seed: int = 0) -> np.ndarray:
+    """Normalised RMS difference (vx, vy, wz) of the learned map from the simulator's
+    quasi-static body velocity (flippers locked) at n training samples' own shape and
+    direction of shape velocity, per unit shape speed: the map where it has data."""
+    rng = np.random.default_rng(seed)
+    rows = samples.iloc[rng.choice(len(samples), size=min(n, len(samples)), replace=False)]
+    ra = rows[["ra_1", "ra_2"]].to_numpy(float)
+    dra = rows[["dra_1", "dra_2"]].to_numpy(float)
+    unit = dra / np.linalg.norm(dra, axis=1, keepdims=True)
+    sim, _ = body_twists(robot_config(SimConfig()), ra, unit)
+    speed = float(np.median(np.linalg.norm(samples[["dra_1", "dra_2"]].to_numpy(float), axis=1)))
+    ask = rows.assign(dra_1=unit[:, 0] * speed, dra_2=unit[:, 1] * speed)
+    ask = ask.assign(trial_id=np.arange(len(ask)) + 1)
+    learned = model.predict(ask)[["vx", "vy", "wz"]].to_numpy(float) / speed
+    return np.sqrt(((learned - sim) ** 2).mean(0)) / np.sqrt((sim**2).mean(0))
 
 
 def main() -> None:
@@ -80,15 +100,19 @@ def main() -> None:
     if args.extra:
         sets["five + extra"] = samples
     args.out.mkdir(parents=True, exist_ok=True)
-    print("| training gaits | samples | shapes inside | vx | vy | wz | mean |")
-    print("|---|---|---|---|---|---|---|")
+    print(
+        "| training gaits | samples | shapes inside | vx | vy | wz | mean "
+        "| map at the data's own directions: vx, vy, wz |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
     for label, s in sets.items():
         fitted = fit_map(s, "GMR")
         conn = learned_connection(fitted.model, decimate(s), args.grid, args.half_range)
         n = compare_connections(conn, reference)
+        d = at_data_directions(fitted.model, decimate(s))
         print(
             f"| {label} | {len(s)} | {n['n_inside']} | {n['vx']:.2f} | {n['vy']:.2f} | "
-            f"{n['wz']:.2f} | {n['mean']:.2f} |",
+            f"{n['wz']:.2f} | {n['mean']:.2f} | {d[0]:.2f}, {d[1]:.2f}, {d[2]:.2f} |",
             flush=True,
         )
         name = "paper" if label.startswith("paper") else "extra"
