@@ -707,12 +707,13 @@ PASSIVE_EXPLANATION = (
     "the same gait (fit on one trial, test on another) from the phase and the actuated "
     "shape's deviations from the mean gait (r_a and dr_a/dt, each times a Fourier series "
     "of the phase), and again with the passive shape's deviations (r_p) added. The gain "
-    "is the ratio of their RMS errors of vx; 1 means r_p carries no information about the "
-    "body's motion that r_a lacks, and then SUDS has nothing to use (F3, F5, F9a need "
-    "the SUDS learners to beat their plain twins, F3 by about 2x). On the simulated robot "
-    "the flippers snap between their stops at the same phase every cycle, so their state "
-    "is a function of the phase and r_a and the gain stays near 1; the paper's robot "
-    "evidently differs. Run it on your own data before a long campaign."
+    "is the ratio of their RMS errors of vx; at or below 1, r_p carries no information "
+    "about the body's motion that r_a lacks (below 1 its extra terms only fit noise), and "
+    "then SUDS has nothing to use (F3, F5, F9a need the SUDS learners to beat their plain "
+    "twins, F3 by about 2x). On the simulated robot the flippers snap between their stops "
+    "at the same phase every cycle, so their state is a function of the phase and r_a and "
+    "the gain is not above 1; the paper's robot evidently differs. Run it on your own data "
+    "before a long campaign."
 )
 
 
@@ -746,12 +747,13 @@ def _pair_rmse(phase: list, vx: list, x: list, order: int) -> np.ndarray:
         b = fourier.basis(p, order)
         return np.concatenate([b] + [b * c[:, None] for c in xi.T], axis=1)
 
+    designs = [design(p, xi) for p, xi in zip(phase, x, strict=True)]
     out = []
     for i in range(len(vx)):
-        coef = np.linalg.lstsq(design(phase[i], x[i]), vx[i], rcond=1e-8)[0]
+        coef = np.linalg.lstsq(designs[i], vx[i], rcond=1e-8)[0]
         for j in range(len(vx)):
             if j != i:
-                pred = design(phase[j], x[j]) @ coef
+                pred = designs[j] @ coef
                 out.append(float(np.sqrt(np.mean((pred - vx[j]) ** 2))))
     return np.array(out)
 
@@ -783,7 +785,8 @@ def passive_information(
     DataFrame, one row per frequency: ``frequency_hz``, ``n_pairs``, ``rmse_ra`` and
     ``rmse_ra_rp`` (median over pairs of the out-of-sample RMS error of vx, mm/s, from
     phase + r_a deviations and from phase + r_a + r_p deviations), ``gain``
-    (rmse_ra / rmse_ra_rp; > 1: r_p adds information) and its 95 % interval
+    (rmse_ra / rmse_ra_rp; > 1: r_p adds information, < 1: its terms fit noise) and its
+    95 % interval
     ``gain_low``, ``gain_high``.
     """
     from suds_exp.models import fourier
