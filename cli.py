@@ -67,9 +67,10 @@ def user_message(exc: SudsError, flags: dict[str, str] | None = None) -> str:
     return text
 
 
-def command(*args, flags: dict[str, str] | None = None, **kwargs):
-    """`app.command` that turns a `SudsError` into one line on stderr and exit code 2;
-    ``flags`` maps this command's library parameters to flags where `flag` would not."""
+def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None = None, **kwargs):
+    """`app.command` (or ``on``'s, a sub-app) that turns a `SudsError` into one line on
+    stderr and exit code 2; ``flags`` maps this command's library parameters to flags
+    where `flag` would not."""
 
     def wrap(fn):
         @functools.wraps(fn)
@@ -82,7 +83,7 @@ def command(*args, flags: dict[str, str] | None = None, **kwargs):
                 )
                 raise typer.Exit(2) from None
 
-        return app.command(*args, **kwargs)(run)
+        return (on or app).command(*args, **kwargs)(run)
 
     return wrap
 
@@ -258,14 +259,36 @@ def simulate(
     seed: Annotated[int, typer.Option(help="Same seed, same files.")] = 0,
     effect: EffectOption = None,
     ingest: Annotated[bool, typer.Option("--ingest", help="Ingest the result into --db.")] = False,
+    gait_file: Annotated[
+        Path | None,
+        typer.Option(help="A gait file (CSV phase_rad,phi1_rad,phi2_rad or Fourier TOML)."),
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
 ) -> None:
     """Simulate the swimmer and write QTM TSV captures, truth Parquet files and a manifest.
 
-    Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on
+    Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on;
+    suds-exp simulate --out ell --gait-file ellipse.toml --freqs 1/2 --ingest
     """
+    if gait_file is not None:
+        _simulate_gait_file(
+            gait_file,
+            out,
+            config,
+            gaits,
+            freqs,
+            repeats,
+            cycles,
+            seed,
+            effect,
+            ingest,
+            db,
+            json_,
+            quiet,
+        )
+        return
     from suds_exp.sim.commands import (
         build_config,
         parse_cycles,
@@ -296,6 +319,38 @@ def simulate(
         console.out.print(
             f"wrote {summary['n_trials']} trials ({summary['simulated_seconds']:.0f} s of robot "
             f"time in {summary['wall_seconds']:.1f} s) and {summary['manifest']}"
+            + (f"; ingested trials {summary['trial_ids']}" if summary["trial_ids"] else "")
+        )
+
+
+def _simulate_gait_file(
+    gait_file, out, config, gaits, freqs, repeats, cycles, seed, effect, ingest, db, json_, quiet
+) -> None:
+    from suds_exp.errors import ConfigError
+    from suds_exp.gait.commands import simulate_file_command
+    from suds_exp.sim.commands import build_config, parse_cycles, parse_freqs
+
+    if gaits:
+        raise ConfigError("use just one of --gaits and --gait-file", param="gaits")
+    if any("@" in e for e in effect or []):
+        raise ConfigError("--gait-file takes effects without a schedule (NAME=VALUE)")
+    summary = simulate_file_command(
+        out,
+        gait_file,
+        build_config(config, effect or []),
+        frequencies_hz=parse_freqs(freqs),
+        repeats=repeats,
+        cycles=parse_cycles(cycles),
+        seed=seed,
+        store=open_store(db) if ingest else None,
+        progress=not (quiet or json_),
+    )
+    if json_:
+        console.print_json(summary)
+    else:
+        console.out.print(
+            f"wrote {summary['n_trials']} trials of {summary['gait']} "
+            f"({summary['simulated_seconds']:.0f} s of robot time) and {summary['manifest']}"
             + (f"; ingested trials {summary['trial_ids']}" if summary["trial_ids"] else "")
         )
 
@@ -603,14 +658,24 @@ def findings(
 
     Example: suds-exp findings paper --json
     """
+    from suds_exp.analysis.findings import (
+        campaign_passive_information,
+        findings_json,
+        print_findings,
+        print_passive_information,
+    )
     from suds_exp.analysis.findings import findings as measure
-    from suds_exp.analysis.findings import findings_json, print_findings
 
-    table = measure(open_store(db), name, n_boot=boot, seed=seed)
+    store = open_store(db)
+    table = measure(store, name, n_boot=boot, seed=seed)
+    passive = campaign_passive_information(store, name, n_boot=boot, seed=seed)
     if json_:
-        console.print_json(findings_json(table, name))
+        doc = findings_json(table, name)
+        doc["passive_information"] = passive.to_dict(orient="records")
+        console.print_json(doc)
     else:
         print_findings(table, name)
+        print_passive_information(passive)
 
 
 @command(flags={"exclude": "--exclude-candidates", "model_effects": "--model-effect"})
@@ -794,6 +859,159 @@ def stream(
     )
     if plot is not None:
         console.out.print(f"wrote {summary['plot']}")
+
+
+gait_app = typer.Typer(
+    help="Gaits: predict a gait's motion, draw the learned connection, design and verify.",
+    no_args_is_help=True,
+)
+app.add_typer(gait_app, name="gait")
+PrepOption = Annotated[
+    str | None, typer.Option(help="Preprocessing version (default: the only one).")
+]
+LearnerOption = Annotated[str, typer.Option(help="Learner name (see suds_exp.models).")]
+
+
+@command(on=gait_app, name="predict", flags={"frequency_hz": "--freq", "n_boot": "--boot"})
+def gait_predict(
+    gait_file: Annotated[Path, typer.Option(help="CSV phase_rad,phi1_rad,phi2_rad or TOML.")],
+    freq: Annotated[str, typer.Option(help="Gait frequency, Hz (e.g. 1/2).")] = "0.5",
+    prep: PrepOption = None,
+    learner: LearnerOption = "GMR",
+    trials_: Annotated[
+        str | None, typer.Option("--trials", help="Training trial ids (default: all).")
+    ] = None,
+    boot: Annotated[int, typer.Option(help="Bootstrap refits for the intervals.")] = 10,
+    bound: Annotated[float, typer.Option(help="Joint bound the gait must keep, rad.")] = 2.0,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Predict a gait's net motion per cycle (forward_mm, lateral_mm, turn_rad, mean_vx_mm_s)
+    from a learner fitted on the version's trials, by the SE(2) path-ordered integral.
+
+    Example: suds-exp gait predict --gait-file ellipse.toml --freq 1/2 --learner GMR --json
+    """
+    from suds_exp.gait.commands import predict_command
+    from suds_exp.preprocess import parse_trial_ids
+    from suds_exp.sim.commands import parse_freqs
+
+    (frequency,) = parse_freqs(freq)[:1]
+    doc = predict_command(
+        open_store(db), gait_file, frequency, prep, learner, parse_trial_ids(trials_), boot, bound
+    )
+    if json_:
+        console.print_json(doc)
+        return
+    ci = doc["interval"].get("forward_mm")
+    console.out.print(
+        f"{doc['gait']} at {doc['frequency_hz']:g} Hz ({learner}): forward "
+        f"{doc['forward_mm']:.1f} mm/cycle"
+        + (f" [{ci[0]:.1f}, {ci[1]:.1f}]" if ci else "")
+        + f", lateral {doc['lateral_mm']:.1f} mm, turn {doc['turn_rad']:.3f} rad, "
+        f"mean vx {doc['mean_vx_mm_s']:.1f} mm/s"
+    )
+
+
+@command(on=gait_app, name="design", flags={"frequency_hz": "--freq"})
+def gait_design(
+    bound: Annotated[float, typer.Option(help="Joint bound |phi1|, |phi2| <= RAD.")] = 1.3,
+    iterations: Annotated[int, typer.Option(help="Design iterations.")] = 5,
+    verify: Annotated[
+        bool, typer.Option("--verify", help="Run each design on the simulator and learn it.")
+    ] = False,
+    prep: PrepOption = None,
+    learner: LearnerOption = "GMR",
+    freq: Annotated[str, typer.Option(help="Gait frequency, Hz.")] = "0.5",
+    order: Annotated[int, typer.Option(help="Fourier harmonics per joint.")] = 2,
+    out: Annotated[Path, typer.Option(help="Folder for verify trials and the report.")] = Path(
+        "gait-design"
+    ),
+    config: SimConfigOption = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Design a gait for forward displacement per cycle inside the bound and the trust
+    region of the learned map; with --verify, the data-driven loop on the simulator.
+
+    Every iteration is stored (table gait_design_iterations).
+    Example: suds-exp gait design --bound 1.3 --iterations 5 --verify --json
+    """
+    from suds_exp.gait.commands import design_command
+    from suds_exp.gait.design import DesignOptions
+    from suds_exp.sim.commands import build_config, parse_freqs
+
+    options = DesignOptions(
+        learner=learner,
+        bound=bound,
+        iterations=iterations,
+        verify=verify,
+        frequency_hz=parse_freqs(freq)[0],
+        order=order,
+    )
+
+    def say(it) -> None:
+        if not json_:
+            ach = f", achieved {it.achieved.forward_mm:.1f}" if it.achieved else ""
+            console.out.print(
+                f"iteration {it.iteration}: predicted {it.predicted.forward_mm:.1f} mm/cycle"
+                f"{ach}; trust radius {it.trust_radius:.3f} ({it.seconds:.0f} s)"
+            )
+
+    doc = design_command(
+        open_store(db), prep, options, out, build_config(config, []) if config else None, say
+    )
+    if json_:
+        console.print_json(doc)
+    else:
+        console.out.print(f"design {doc['design_id']} stored; report {doc['report']}")
+
+
+@command(on=gait_app, name="connection", flags={"half_range": "--range"})
+def gait_connection(
+    out: Annotated[Path, typer.Option(help="CSV file; the figure goes beside it (.png).")],
+    prep: PrepOption = None,
+    learner: LearnerOption = "GMR",
+    grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,
+    range_: Annotated[float, typer.Option("--range", help="Half range of phi1, phi2 (rad).")] = 2.0,
+    compare: Annotated[
+        bool, typer.Option("--compare", help="Beside the simulator's connection (locked).")
+    ] = False,
+    gait_file: Annotated[
+        list[Path] | None, typer.Option(help="Gait files to overlay; repeatable.")
+    ] = None,
+    config: SimConfigOption = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """The learned local connection, its curl (height function) and support, drawn as
+    sysplotter does; --compare adds the simulator's own and their normalised difference.
+
+    Example: suds-exp gait connection --out reports/learned.csv --compare
+    """
+    from suds_exp.gait.commands import connection_command
+    from suds_exp.sim.commands import build_config
+
+    summary = connection_command(
+        open_store(db),
+        out,
+        prep,
+        learner,
+        grid,
+        range_,
+        compare,
+        build_config(config, []) if config else None,
+        gait_file or [],
+    )
+    if json_:
+        console.print_json(summary)
+        return
+    console.out.print(f"wrote {summary['csv']} and {summary['figure']}")
+    if "normalised_rms" in summary:
+        n = summary["normalised_rms"]
+        console.out.print(
+            f"normalised RMS difference from the simulator inside the support: vx {n['vx']:.2f}, "
+            f"vy {n['vy']:.2f}, wz {n['wz']:.2f}, mean {n['mean']:.2f} ({n['n_inside']} shapes)"
+        )
 
 
 if __name__ == "__main__":

@@ -15,7 +15,14 @@ import pandas as pd
 
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
-from suds_exp.analysis.findings import findings_display, findings_headline, findings_table
+from suds_exp.analysis.findings import (
+    PASSIVE_EXPLANATION,
+    campaign_passive_information,
+    findings_display,
+    findings_headline,
+    findings_table,
+    passive_display,
+)
 from suds_exp.analysis.formatting import to_html, to_markdown, write_table
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
@@ -193,7 +200,18 @@ def write_report(
         files[name] = write_table(frame, out, name, digits.get(name, 2), md)
 
     page = _page(campaign, store, results, size, tables, figures, files, pairs)
-    page = page.replace(_FINDINGS_SLOT, _findings_html(tables["findings"], files["findings"]), 1)
+    passive = campaign_passive_information(store, campaign)
+    passive_files = (
+        write_table(passive, out, "passive_information", 3, to_markdown(passive_display(passive)))
+        if not passive.empty
+        else {}
+    )
+    page = page.replace(
+        _FINDINGS_SLOT,
+        _findings_html(tables["findings"], files["findings"])
+        + _passive_html(passive, passive_files),
+        1,
+    )
     page = page.replace(_SKIPPED_SLOT, _skipped_html(store, campaign), 1)
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")
@@ -220,6 +238,22 @@ def _findings_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
             "documentation (docs/explanation/findings.md) defines every statistic.</p>",
             to_html(findings_display(table)),
             f"<p>Files (with each statistic's definition): {_files(files)}</p>",
+        ]
+    )
+
+
+def _passive_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
+    """The passive-information section (`passive_information`) beside the findings."""
+    head = '<h3 id="passive-information">What the passive shape adds</h3>'
+    if table.empty:
+        return f"\n{head}\n<p>Not measurable: the campaign's samples are not stored.</p>"
+    return "\n".join(
+        [
+            "",
+            head,
+            f'<p class="note">{html.escape(PASSIVE_EXPLANATION)}</p>',
+            to_html(passive_display(table)),
+            f"<p>Files: {_files(files)}</p>",
         ]
     )
 

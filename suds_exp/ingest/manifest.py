@@ -15,6 +15,7 @@ from suds_exp.ingest.tables_csv import read_text_table
 from suds_exp.robot import GAITS, parse_frequency
 
 COLUMNS = ("file", "gait", "frequency_hz", "repeat", "notes")
+GAIT_FILE_SUFFIXES = (".csv", ".toml")
 
 
 @dataclass(frozen=True)
@@ -38,8 +39,12 @@ def read_manifest(path: Path) -> dict[Path, Condition]:
         if not file.is_file():
             raise IngestError(f"{where}: file {row.file.strip()!r} does not exist")
         gait = row.gait.strip()
-        if gait not in GAITS:
-            raise IngestError(f"{where}: unknown gait {gait!r}; expected one of {', '.join(GAITS)}")
+        # a gait file's name (`simulate --gait-file`) names the gait it ran
+        if gait not in GAITS and not gait.lower().endswith(GAIT_FILE_SUFFIXES):
+            raise IngestError(
+                f"{where}: unknown gait {gait!r}; expected one of {', '.join(GAITS)} "
+                "or a gait file's name (.csv, .toml)"
+            )
         try:
             freq = parse_frequency(row.frequency_hz)
         except (ValueError, ZeroDivisionError):

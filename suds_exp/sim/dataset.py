@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -39,11 +40,15 @@ class TrialSpec:
     phase0: float
     pose0: tuple[float, float, float]
     seed: tuple[int, ...]
+    #: A gait from a file (phase rad (n,) -> r_a (n, 2) rad) in place of the named one;
+    #: ``gait`` then holds the file's name.
+    path: Callable | None = field(default=None, compare=False, repr=False)
 
     @property
     def name(self) -> str:
         mhz = int(round(self.frequency_hz * 1000))
-        return f"sim_{_GAIT_FILE_CODE[self.gait]}_{mhz:04d}mHz_r{self.repeat:02d}"
+        code = _GAIT_FILE_CODE.get(self.gait) or re.sub(r"[^A-Za-z0-9_-]+", "-", self.gait)
+        return f"sim_{code}_{mhz:04d}mHz_r{self.repeat:02d}"
 
 
 @dataclass(frozen=True)
@@ -127,7 +132,8 @@ def drive(spec: TrialSpec, cfg: SimConfig) -> tuple[np.ndarray, np.ndarray, np.n
     t = np.arange(n) / rate
     phase = 2 * math.pi * spec.frequency_hz * t + spec.phase0
     rng = np.random.default_rng(np.random.SeedSequence(spec.seed + (1,)))
-    phi = actuate(gait_shape(spec.gait, phase), 1 / rate, cfg.actuator, rng)
+    shape = spec.path(phase) if spec.path is not None else gait_shape(spec.gait, phase)
+    phi = actuate(shape, 1 / rate, cfg.actuator, rng)
     return t, phase, phi
 
 
@@ -196,6 +202,7 @@ def simulate_dataset(
     progress: bool = False,
     batch_size: int = 20,
     changes: Sequence = (),
+    specs: Sequence[TrialSpec] | None = None,
 ) -> SimulatedDataset:
     """Simulate a gait x frequency x repeat design and write its files into out_dir.
 
@@ -203,7 +210,8 @@ def simulate_dataset(
     `manifest.csv`. Default: the paper's design, 5 gaits x 3 frequencies x 4 repeats,
     10-30 cycles each. ``progress``: a bar over the written trials.
     `changes` (`schedule.Change` items) switch effects on during every trial; they are
-    noted in the manifest as ``schedule=NAME=VALUE@Ts``.
+    noted in the manifest as ``schedule=NAME=VALUE@Ts``. ``specs`` (e.g. trials of a
+    gait file, `suds_exp.gait.trials.simulate_gait_file`) replace the planned design.
     """
     cfg = SimConfig() if config is None else config
     out = Path(out_dir)
@@ -211,7 +219,9 @@ def simulate_dataset(
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise ConfigError(f"{out}: cannot create output folder ({exc.strerror})") from None
-    specs = plan_trials(gaits, frequencies_hz, repeats, cycles, seed)
+    if specs is None:
+        specs = plan_trials(gaits, frequencies_hz, repeats, cycles, seed)
+    specs = list(specs)
     if changes:
         from suds_exp.sim.schedule import check_times
 
@@ -243,7 +253,7 @@ def _write_trial(
     measured = measure(cfg, truth_markers(truth, cfg), rng)
     tsv = out / f"{spec.name}.tsv"
     # a plausible session clock: one hour per gait, a minute per repeat
-    g, mhz, r = spec.seed[1], spec.seed[2] // 1000, spec.seed[3]
+    g, mhz, r = spec.seed[1] % 24, spec.seed[2] // 1000, spec.seed[3]
     stamp = _EPOCH + _dt.timedelta(seconds=3600 * g + 60 * r + mhz)
     write_qtm_tsv(tsv, measured, MARKER_NAMES, cfg.measurement.sample_rate_hz, stamp)
     truth_path = out / f"{spec.name}.truth.parquet"

@@ -32,6 +32,7 @@ class DemoSummary:
     report: Path | None = None
     findings: list[dict] = field(default_factory=list)
     findings_headline: str = ""
+    passive_information: list[dict] = field(default_factory=list)
     discrepancy: dict = field(default_factory=dict)
     discrepancy_report: Path | None = None
     seconds: dict[str, float] = field(default_factory=dict)
@@ -153,6 +154,18 @@ def findings_step(store: Store, summary: DemoSummary, say, lap) -> None:
     display = findings_display(table)
     say(display.to_string(index=False, max_colwidth=60))
     say(f"{summary.findings_headline} ({lap('findings'):.0f} s)")
+    from suds_exp.analysis.findings import (
+        PASSIVE_EXPLANATION,
+        campaign_passive_information,
+        passive_display,
+    )
+
+    passive = campaign_passive_information(store, campaign)
+    summary.passive_information = passive.to_dict(orient="records")
+    if not passive.empty:
+        say("what the passive shape adds (out-of-sample RMS error of vx, mm/s):")
+        say(passive_display(passive).to_string(index=False))
+        say(PASSIVE_EXPLANATION)
 
 
 def discrepancy_step(summary: DemoSummary, out: Path, hidden_effect: str, seed: int, say, lap):

@@ -1,0 +1,126 @@
+"""The work behind `suds-exp gait predict | design | connection` and `simulate
+--gait-file` (the CLI only parses options and prints): each returns a JSON-ready dict."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from suds_exp.errors import ConfigError
+from suds_exp.gait.connection import compare_connections, learned_connection
+from suds_exp.gait.design import Design, DesignOptions, design_gait
+from suds_exp.gait.plots import draw_connection, draw_design
+from suds_exp.gait.predict import decimate, fit_map, predict_gait
+from suds_exp.gait.shape import JOINT_LIMIT_RAD, read_gait_file
+from suds_exp.gait.trials import simulate_gait_file
+from suds_exp.models import make_model
+from suds_exp.preprocess import get_version
+from suds_exp.sim import SimConfig, local_connection
+
+
+def predict_command(
+    store,
+    gait_file: Path,
+    frequency_hz: float,
+    prep=None,
+    learner: str = "GMR",
+    trials: Sequence[int] | None = None,
+    n_boot: int = 10,
+    bound: float = JOINT_LIMIT_RAD,
+) -> dict:
+    """`gait predict`: the gait file's predicted net motion per cycle (keys of
+    `GaitPrediction.to_dict`). The file and the learner are checked before any fit."""
+    gait = read_gait_file(gait_file, bound)
+    make_model(learner)
+    if n_boot < 0:
+        raise ConfigError(f"n_boot {n_boot}: must be >= 0", param="n_boot")
+    return predict_gait(store, prep, learner, gait, frequency_hz, trials, n_boot).to_dict()
+
+
+def design_command(
+    store,
+    prep=None,
+    options: DesignOptions | None = None,
+    out: Path = Path("gait-design"),
+    config: SimConfig | None = None,
+    progress=None,
+) -> dict:
+    """`gait design`: run the design loop (stored), write its report page (Markdown and
+    a PNG under ``out``/design-ID/) and return the design as a dict."""
+    design = design_gait(store, prep, options, out, config, progress)
+    doc = design.to_dict()
+    doc["report"] = str(write_design_report(store, design, Path(out)))
+    return doc
+
+
+def write_design_report(store, design: Design, out: Path) -> Path:
+    """``out``/design-ID/report.md and design.png: the gaits on the learned height
+    function (learner refitted on the version's samples as they are now), displacement
+    per iteration, predicted against achieved, and a table of the iterations."""
+    folder = out / f"design-{design.id}"
+    samples = get_version(store, design.prep_version).samples()
+    fitted = fit_map(samples, design.options.learner)
+    conn = learned_connection(fitted.model, decimate(samples), 21, 2.0, k=fitted.k, rp0=fitted.rp0)
+    png = draw_design(design, conn, folder / "design.png")
+    lines = [
+        f"# Gait design {design.id}",
+        "",
+        f"Version {design.prep_version}, learner {design.options.learner}, bound "
+        f"{design.options.bound:g} rad, {design.options.frequency_hz:g} Hz, Fourier order "
+        f"{design.options.order}, verify {design.options.verify}.",
+        "",
+        f"![design]({png.name})",
+        "",
+        "| iteration | predicted (mm/cycle) | achieved (mm/cycle) | trust radius | "
+        "distance from data | trial |",
+        "|---|---|---|---|---|---|",
+    ]
+    for it in design.iterations:
+        ach = f"{it.achieved.forward_mm:.1f}" if it.achieved else "-"
+        lines.append(
+            f"| {it.iteration} | {it.predicted.forward_mm:.1f} | {ach} | {it.trust_radius:.3f} | "
+            f"{it.support_distance:.3f} | {it.trial_id or '-'} |"
+        )
+    path = folder / "report.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def connection_command(
+    store,
+    out: Path,
+    prep=None,
+    learner: str = "GMR",
+    grid: int = 21,
+    half_range: float = 2.0,
+    compare: bool = False,
+    config: SimConfig | None = None,
+    gait_files: Sequence[Path] = (),
+) -> dict:
+    """`gait connection`: the learned connection of version ``prep`` on a grid (CSV at
+    ``out``, figure beside it as .png), with ``compare`` the simulator's own connection
+    (flippers locked, ``config``) on the same grid and their normalised difference."""
+    make_model(learner)
+    gaits = [read_gait_file(p) for p in gait_files]
+    if grid < 3:
+        raise ConfigError(f"grid {grid}: need at least 3 points per axis", param="grid")
+    samples = get_version(store, prep).samples()
+    fitted = fit_map(samples, learner)
+    conn = learned_connection(
+        fitted.model, decimate(samples), grid, half_range, k=fitted.k, rp0=fitted.rp0
+    )
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    conn.to_frame().to_csv(out, index=False, float_format="%.8g")
+    reference = None
+    summary: dict = {"csv": str(out), "learner": learner, "n_inside": int(conn.inside.sum())}
+    if compare:
+        reference = local_connection(grid, half_range, "robot", config or SimConfig()).A
+        summary["normalised_rms"] = compare_connections(conn, reference)
+    summary["figure"] = str(draw_connection(conn, out.with_suffix(".png"), reference, gaits))
+    return summary
+
+
+def simulate_file_command(out: Path, gait_file: Path, config=None, **kwargs) -> dict:
+    """`simulate --gait-file`: trials of the gait file (see `simulate_gait_file`)."""
+    return simulate_gait_file(out, read_gait_file(gait_file), config, **kwargs)

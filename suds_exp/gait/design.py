@@ -1,0 +1,348 @@
+"""Design a gait from a learned motility map, and verify it: the data-driven loop.
+
+Each iteration fits the learner on the version's samples, then maximises the predicted
+forward displacement per cycle over the Fourier coefficients of both joints (order
+``order``) subject to
+
+- the joint bound: |phi1|, |phi2| <= bound (rad), and
+- the trust region: the gait's distance from the training data in the
+  (shape, direction of shape velocity) metric of `suds_exp.gait.support` is at most the
+  trust radius. A learned map interpolates; far from its data it guesses. The radius
+  starts small and follows the classical trust-region rule on the verified prediction:
+  it grows (x `grow`) when the simulator achieved what the map predicted within
+  `accept_error`, and shrinks (x `shrink`) when it did not.
+
+With ``verify`` each designed gait is run on the simulator as a new trial (10 cycles at
+the design frequency through the actuator, like any capture), ingested and preprocessed
+into the same version, so the next iteration's map has seen it: the support grows where
+the designer is going. Its achieved motion is measured on the simulator by
+`suds_exp.gait.truth` (the same measurement as the ceiling benchmark). Without
+``verify`` the data never change and each iteration only widens the trust radius.
+
+Every iteration is stored in ``gait_design_iterations`` (migration 017).
+
+The optimiser is Nelder-Mead with penalties (a fitted map is cheap, a few ms a gait, but
+not smooth enough for gradients), started from the best gait so far and from the paper's
+circle O.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import sqlalchemy as sa
+from scipy.optimize import minimize
+
+from suds_exp.errors import ConfigError
+from suds_exp.gait.motion import CycleMotion
+from suds_exp.gait.predict import decimate, derive_seed, fit_map
+from suds_exp.gait.shape import FourierGait, check_bound, within_bound
+from suds_exp.gait.support import Support
+from suds_exp.gait.trials import simulate_gait_file
+from suds_exp.gait.truth import simulate_gaits
+from suds_exp.models import make_model
+from suds_exp.preprocess import get_version
+from suds_exp.preprocess import preprocess as run_preprocess
+from suds_exp.sim import SimConfig
+from suds_exp.store import Store
+
+#: Penalty (mm of forward displacement) per rad beyond the bound or the trust radius.
+PENALTY_MM_PER_RAD = 500.0
+
+
+@dataclass
+class DesignOptions:
+    """The recipe of a design run (stored as its definition).
+
+    bound (rad), frequency_hz (Hz), order (Fourier harmonics), trust0 (rad, first trust
+    radius), trust_max (rad), grow / shrink (radius factors), accept_error (relative
+    prediction error that counts as trusted), max_evals (map evaluations per start),
+    cycles (of a verify trial).
+    """
+
+    learner: str = "GMR"
+    bound: float = 1.3
+    iterations: int = 5
+    verify: bool = False
+    frequency_hz: float = 0.5
+    order: int = 2
+    trust0: float = 0.15
+    trust_max: float = 0.4
+    grow: float = 1.5
+    shrink: float = 0.5
+    accept_error: float = 0.2
+    max_evals: int = 400
+    cycles: int = 10
+
+    def check(self) -> None:
+        if not 0 < self.bound <= 3.0:
+            raise ConfigError(f"bound {self.bound}: expected 0 < bound <= 3 rad", param="bound")
+        if self.iterations < 1:
+            raise ConfigError(f"iterations {self.iterations}: must be >= 1", param="iterations")
+        if not 1 <= self.order <= 5:
+            raise ConfigError(f"order {self.order}: expected 1..5 harmonics", param="order")
+        if not self.frequency_hz > 0:
+            raise ConfigError(f"frequency {self.frequency_hz}: must be > 0 Hz", param="freq")
+
+
+@dataclass
+class Iteration:
+    """One design iteration: the gait, its predicted and (verify) achieved motion."""
+
+    iteration: int
+    gait: FourierGait
+    predicted: CycleMotion
+    achieved: CycleMotion | None
+    trust_radius: float
+    support_distance: float
+    support: dict
+    trial_id: int | None
+    seconds: float
+
+    def to_dict(self) -> dict:
+        out = {"iteration": self.iteration} | self.gait.to_dict()
+        out["coefficients"] = self.gait.to_vector().round(6).tolist()
+        out["predicted"] = self.predicted.to_dict()
+        if self.achieved is not None:
+            out["achieved"] = self.achieved.to_dict()
+        out |= {
+            "trust_radius": round(self.trust_radius, 4),
+            "support_distance": round(self.support_distance, 4),
+            "support": self.support,
+            "trial_id": self.trial_id,
+            "seconds": round(self.seconds, 2),
+        }
+        return out
+
+
+@dataclass
+class Design:
+    """A design run: its id in the store, options and iterations."""
+
+    id: int
+    prep_version: int
+    options: DesignOptions
+    iterations: list[Iteration] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return {
+            "design_id": self.id,
+            "prep_version": self.prep_version,
+            "options": asdict(self.options),
+            "iterations": [it.to_dict() for it in self.iterations],
+        }
+
+
+def circle(radius: float, order: int, name: str = "circle") -> FourierGait:
+    """phi1 = r cos, phi2 = r sin (the paper's O at r = 1) with ``order`` harmonics."""
+    a = np.zeros((order, 2))
+    b = np.zeros((order, 2))
+    a[0, 0] = b[0, 1] = radius
+    return FourierGait([0.0, 0.0], a, b, name)
+
+
+def optimise_gait(
+    objective,
+    support: Support,
+    bound: float,
+    trust: float,
+    starts: list[FourierGait],
+    max_evals: int = 800,
+    name: str = "design",
+) -> tuple[FourierGait, float]:
+    """Maximise ``objective(gait)`` (mm) over Fourier gaits within ``bound`` (rad) and
+    the trust radius ``trust`` (rad) from ``support``; Nelder-Mead from each start.
+    Returns (best gait, its objective)."""
+
+    def penalised(x):
+        g = within_bound(FourierGait.from_vector(x, name), bound)
+        excess = support.gait_distance(g) - trust
+        if excess > 0:
+            # outside: only the way back counts, so the search cannot trade for it
+            return PENALTY_MM_PER_RAD * (1 + excess)
+        return -objective(g)
+
+    best_x, best_f = None, np.inf
+    for s in starts:
+        x0 = s.to_vector()
+        res = minimize(
+            penalised,
+            x0,
+            method="Nelder-Mead",
+            options={"maxfev": max_evals, "xatol": 1e-3, "fatol": 1e-2, "adaptive": True},
+        )
+        for x, f in ((res.x, res.fun), (x0, penalised(x0))):
+            if f < best_f:
+                best_x, best_f = x, f
+    best = within_bound(FourierGait.from_vector(best_x, name), bound)
+    # the search kept the bound on 256 phases; make it hold on a finer grid too
+    while best.max_abs() > bound:
+        best = FourierGait(best.a0, best.a * 0.999, best.b * 0.999, name)
+    return best, objective(best)
+
+
+def _fit_inside(gait: FourierGait, support: Support, bound: float, trust: float) -> FourierGait:
+    """The start shrunk towards its centre until it is inside bound and trust region."""
+    for scale in np.linspace(1.0, 0.3, 15):
+        x = gait.to_vector().copy()
+        x[2:] *= scale
+        g = FourierGait.from_vector(x, gait.name)
+        if g.max_abs(128) <= bound and support.gait_distance(g) <= trust:
+            return g
+    return gait
+
+
+def design_gait(
+    store: Store,
+    prep=None,
+    options: DesignOptions | None = None,
+    out: str | Path = "gait-design",
+    config: SimConfig | None = None,
+    progress=None,
+) -> Design:
+    """`gait design`: the design loop on version ``prep`` (see the module docstring).
+
+    out: folder for the verify trials' files and the designed gaits' TOML; config: the
+    simulator of the verify trials (default nominal). ``progress``: called with each
+    finished `Iteration`. Returns the `Design`, already stored.
+    """
+    opts = options or DesignOptions()
+    opts.check()
+    make_model(opts.learner)  # an unknown learner is refused before anything is stored
+    version = get_version(store, prep)
+    samples = version.samples()
+    if samples.empty:
+        raise ConfigError(f"version {version.name} has no samples; run `suds-exp preprocess`")
+    design_id = _register(store, version.id, opts)
+    design = Design(design_id, version.id, opts)
+    out = Path(out)
+    trust = opts.trust0
+    best = circle(1.0, opts.order, "O")
+    best_achieved = -np.inf
+    for it in range(1, opts.iterations + 1):
+        started = time.perf_counter()
+        fitted = fit_map(samples, opts.learner)
+        support = Support.of(decimate(samples))
+        name = f"design-{design_id}-it{it}.toml"
+        starts = [
+            _fit_inside(g, support, opts.bound, trust) for g in (best, circle(1.0, opts.order))
+        ]
+        gait, _ = optimise_gait(
+            lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
+            support,
+            opts.bound,
+            trust,
+            starts,
+            opts.max_evals,
+            name,
+        )
+        check_bound(gait, opts.bound, name)
+        predicted = fitted.motion(gait, opts.frequency_hz)
+        distance = support.gait_distance(gait)
+        summary = support.summary() | {"n_trials": int(samples["trial_id"].nunique())}
+        achieved, trial_id = None, None
+        if opts.verify:
+            trial_id = _verify_trial(store, version, gait, opts, out, design_id, it, config)
+            achieved = simulate_gaits([gait], opts.frequency_hz, config)[0]
+            error = abs(predicted.forward_mm - achieved.forward_mm) / max(
+                abs(achieved.forward_mm), 1e-9
+            )
+            used = trust
+            trust = min(
+                opts.trust_max, trust * (opts.grow if error <= opts.accept_error else opts.shrink)
+            )
+            if achieved.forward_mm > best_achieved:
+                best, best_achieved = gait, achieved.forward_mm
+            samples = version.samples()
+        else:
+            used = trust
+            trust = min(opts.trust_max, trust * opts.grow)
+            best = gait
+        record = Iteration(
+            it,
+            gait,
+            predicted,
+            achieved,
+            used,
+            distance,
+            summary,
+            trial_id,
+            time.perf_counter() - started,
+        )
+        _store_iteration(store, design_id, record)
+        design.iterations.append(record)
+        if progress is not None:
+            progress(record)
+    return design
+
+
+def _verify_trial(store, version, gait, opts, out, design_id, it, config) -> int:
+    """Simulate the gait as a capture, ingest it and preprocess it into ``version``;
+    the new trial's id."""
+    folder = out / f"design-{design_id}" / f"it{it}"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / gait.name).write_text(gait.to_toml())
+    seed = derive_seed("gait-design", design_id, it) % 2**31
+    summary = simulate_gait_file(
+        folder, gait, config, (opts.frequency_hz,), 1, (opts.cycles, opts.cycles), seed, store
+    )
+    trial_id = int(summary["trial_ids"][0])
+    run_preprocess(store, version.name, params=version.params, trials=[trial_id], progress=False)
+    return trial_id
+
+
+def _register(store: Store, version_id: int, opts: DesignOptions) -> int:
+    with store.write() as conn:
+        return int(
+            conn.execute(
+                sa.text(
+                    "INSERT INTO gait_designs (prep_version, learner, bound_rad, frequency_hz, "
+                    "definition, created_at) VALUES (:v, :l, :b, :f, :d, :c) RETURNING id"
+                ),
+                {
+                    "v": version_id,
+                    "l": opts.learner,
+                    "b": opts.bound,
+                    "f": opts.frequency_hz,
+                    "d": json.dumps(asdict(opts), sort_keys=True),
+                    "c": datetime.now(UTC).replace(tzinfo=None),
+                },
+            ).scalar_one()
+        )
+
+
+def _store_iteration(store: Store, design_id: int, it: Iteration) -> None:
+    row = {
+        "design_id": design_id,
+        "iteration": it.iteration,
+        "gait": json.dumps(
+            it.gait.to_dict()
+            | {"coefficients": it.gait.to_vector().tolist(), "order": it.gait.order}
+        ),
+        "trust_radius": it.trust_radius,
+        "support_distance": it.support_distance,
+        "support": json.dumps(it.support),
+        "trial_id": it.trial_id,
+        "seconds": it.seconds,
+    }
+    for prefix, m in (("predicted", it.predicted), ("achieved", it.achieved)):
+        for key in ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s"):
+            row[f"{prefix}_{key}"] = None if m is None else getattr(m, key)
+    with store.write() as conn:
+        Store.insert_df(conn, "gait_design_iterations", pd.DataFrame([row]))
+
+
+def load_design(store: Store, design_id: int) -> pd.DataFrame:
+    """The stored iterations of design ``design_id``, in order (one row each)."""
+    with store.read() as conn:
+        return Store.frame(
+            conn,
+            "SELECT * FROM gait_design_iterations WHERE design_id = ? ORDER BY iteration",
+            [int(design_id)],
+        )

@@ -1,0 +1,248 @@
+"""Predict what a gait does from a learned motility map.
+
+The learner is fitted on a preprocessing version's trials (decimated to the same samples
+per cycle at every frequency by the campaign's rule: the fewest of any trial), rolled over
+the gait and the body's path reconstructed by the path-ordered SE(2) integral
+(`suds_exp.gait.motion`):
+
+- phase-free learners (GMR) see only (r_a, dr_a/dt) of the gait;
+- phase-based learners (phase-only, TLS) get the gait's own phase as ``phase``;
+- SUDS learners run in ``mode="rollout"``: r_p starts at the training mean and follows
+  their own passive dynamics along the gait.
+
+The gait is rolled for `N_CYCLES` cycles and cycles `MEASURED` are averaged (the rollout
+of r_p settles first); a learner without memory (no r_p, no branching) needs one cycle.
+A bootstrap over training trials (resampled with replacement,
+seeds derived from the request) gives each number's interval.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.errors import ConfigError
+from suds_exp.gait.motion import CycleMotion, cycle_motion, integrate_twists
+from suds_exp.gait.shape import TWO_PI, Gait
+from suds_exp.models import make_model
+from suds_exp.preprocess import get_version
+from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
+
+#: Cycles rolled and the cycles (0-based) averaged.
+N_CYCLES = 4
+MEASURED = (2, 3)
+#: Samples per cycle of the rolled gait (and of training data whose rate is unknown).
+SAMPLES_PER_CYCLE = 100
+MOTION_KEYS = ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s")
+
+
+def derive_seed(*key) -> int:
+    """A 32-bit seed from a JSON-able key (stable across runs and machines)."""
+    text = json.dumps([str(k) for k in key])
+    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:4], "little")
+
+
+def _raw_samples_per_cycle(trial: pd.DataFrame) -> float:
+    dt = float(np.median(np.diff(trial["t"].to_numpy()))) if len(trial) > 1 else np.nan
+    f = float(trial["frequency_hz"].iloc[0]) if "frequency_hz" in trial else np.nan
+    return 1 / (f * dt) if np.isfinite(f) and f > 0 and dt > 0 else np.nan
+
+
+def decimate(samples: pd.DataFrame, samples_per_cycle: int | None = None) -> pd.DataFrame:
+    """Every trial's samples thinned to about ``samples_per_cycle`` per cycle (plain
+    decimation by a whole factor from its frequency and sample spacing). None: the
+    campaign's rule (`suds_exp.campaign.bank`), the fewest samples per cycle of any
+    trial, so every frequency ends with the same."""
+    trials = [t for _, t in samples.groupby("trial_id", sort=True)]
+    raw = [_raw_samples_per_cycle(t) for t in trials]
+    if samples_per_cycle is None:
+        finite = [r for r in raw if np.isfinite(r)]
+        samples_per_cycle = int(round(min(finite))) if finite else SAMPLES_PER_CYCLE
+    parts = [
+        t.iloc[:: max(1, int(round(r / samples_per_cycle))) if np.isfinite(r) else 1]
+        for t, r in zip(trials, raw, strict=True)
+    ]
+    return pd.concat(parts) if parts else samples
+
+
+def gait_samples(
+    gait: Gait,
+    frequency_hz: float,
+    k: int = 0,
+    rp0: np.ndarray | None = None,
+    n_cycles: int = N_CYCLES,
+    samples_per_cycle: int = SAMPLES_PER_CYCLE,
+) -> pd.DataFrame:
+    """A samples frame of the gait run at frequency_hz (Hz) from phase 0: the standard
+    columns (t s, phase rad, ra rad, dra rad/s), r_p (k columns) held at rp0 (mm) for
+    a rollout's start, dr_p/dt and v_b as NaN."""
+    n = n_cycles * samples_per_cycle + 1
+    theta = TWO_PI * np.arange(n) / samples_per_cycle
+    ra = gait.shape(theta)
+    dra = gait.rate(theta) * TWO_PI * frequency_hz
+    cols = {
+        "trial_id": np.zeros(n, dtype=np.int64),
+        "frame": np.arange(n),
+        "t": theta / (TWO_PI * frequency_hz),
+        "phase": theta,
+        "cycle": np.arange(n) // samples_per_cycle,
+        "ra_1": ra[:, 0],
+        "ra_2": ra[:, 1],
+        "dra_1": dra[:, 0],
+        "dra_2": dra[:, 1],
+    }
+    rp0 = np.zeros(k) if rp0 is None else np.asarray(rp0, float)
+    for j in range(k):
+        cols[RP_COLUMNS[j]] = np.full(n, rp0[j])
+        cols[DRP_COLUMNS[j]] = np.zeros(n)
+    for c in ("vx", "vy", "wz"):
+        cols[c] = np.full(n, np.nan)
+    cols["frequency_hz"] = np.full(n, float(frequency_hz))
+    return pd.DataFrame(cols)
+
+
+def build_learner(name: str, params: dict | None = None):
+    """`make_model(name, **params)`; SUDS learners switched to their rollout mode (a new
+    gait has no measured r_p)."""
+    model = make_model(name, **(params or {}))
+    if "mode" in model.get_params():
+        model.set_params(mode="rollout")
+    return model
+
+
+def rollout_motion(
+    model,
+    gait: Gait,
+    frequency_hz: float,
+    k: int = 0,
+    rp0: np.ndarray | None = None,
+    samples_per_cycle: int = SAMPLES_PER_CYCLE,
+) -> CycleMotion:
+    """Net motion per cycle of ``gait`` at frequency_hz predicted by a fitted ``model``
+    (SE(2) integral of its predicted v_b; mean of cycles `MEASURED`)."""
+    # a learner without memory (no r_p to roll, no branch history) repeats every cycle
+    memoryless = k == 0 and getattr(model, "branching", "none") == "none"
+    cycles, measured = ((1,), (0,)) if memoryless else ((N_CYCLES,), MEASURED)
+    frame = gait_samples(gait, frequency_hz, k, rp0, cycles[0], samples_per_cycle)
+    vb = model.predict(frame)[["vx", "vy", "wz"]].to_numpy(float)
+    dt = 1 / (frequency_hz * samples_per_cycle)
+    poses = integrate_twists(vb, dt)
+    return cycle_motion(poses, samples_per_cycle, measured, vb[:, 0])
+
+
+@dataclass
+class FittedMap:
+    """A learner fitted on training samples, with what a rollout needs: k (r_p columns)
+    and rp0 (k,) mm, the training mean of r_p."""
+
+    model: object
+    k: int
+    rp0: np.ndarray
+
+    def motion(self, gait: Gait, frequency_hz: float) -> CycleMotion:
+        return rollout_motion(self.model, gait, frequency_hz, self.k, self.rp0)
+
+    def forward(self, gait: Gait, frequency_hz: float) -> float:
+        return self.motion(gait, frequency_hz).forward_mm
+
+
+def fit_map(
+    samples: pd.DataFrame,
+    learner: str = "GMR",
+    params: dict | None = None,
+    samples_per_cycle: int | None = None,
+) -> FittedMap:
+    """Fit ``learner`` on ``samples`` (the version's frame; decimated here as a campaign
+    does, see `decimate`)."""
+    train = decimate(samples, samples_per_cycle)
+    k = sum(1 for c in RP_COLUMNS if c in train.columns)
+    rp0 = train[list(RP_COLUMNS[:k])].mean().to_numpy(float) if k else np.zeros(0)
+    model = build_learner(learner, params).fit(train)
+    return FittedMap(model, k, rp0)
+
+
+@dataclass
+class GaitPrediction:
+    """Predicted motion of one gait (point fit on all training trials) and bootstrap
+    intervals (2.5 and 97.5 percentiles over ``n_boot`` refits on resampled trials)."""
+
+    gait: Gait
+    frequency_hz: float
+    learner: str
+    motion: CycleMotion
+    interval: dict = field(default_factory=dict)
+    n_boot: int = 0
+
+    def to_dict(self) -> dict:
+        out = {"gait": self.gait.name, "frequency_hz": self.frequency_hz, "learner": self.learner}
+        out |= self.motion.to_dict()
+        out["n_boot"] = self.n_boot
+        out["interval"] = self.interval
+        return out
+
+
+def predict_gaits(
+    samples: pd.DataFrame,
+    gaits: Sequence[Gait],
+    frequency_hz: float,
+    learner: str = "GMR",
+    params: dict | None = None,
+    n_boot: int = 0,
+    seed: int = 0,
+) -> list[GaitPrediction]:
+    """Predict each gait's net motion per cycle at frequency_hz (Hz) from a learner fitted
+    on ``samples``; with n_boot > 0, also a bootstrap interval over training trials."""
+    if not frequency_hz > 0:
+        raise ConfigError(f"frequency {frequency_hz!r}: must be > 0 Hz", param="freq")
+    fitted = fit_map(samples, learner, params)
+    points = [fitted.motion(g, frequency_hz) for g in gaits]
+    boots = np.empty((n_boot, len(gaits), len(MOTION_KEYS)))
+    ids = np.array(sorted(samples["trial_id"].unique()))
+    groups = dict(tuple(samples.groupby("trial_id", sort=False)))
+    for b in range(n_boot):
+        rng = np.random.default_rng([seed, b])
+        draw = rng.choice(ids, size=len(ids), replace=True)
+        # each drawn trial is a separate series (duplicates renumbered, not merged)
+        frame = pd.concat(
+            [groups[t].assign(trial_id=i + 1) for i, t in enumerate(draw)], ignore_index=True
+        )
+        fb = fit_map(frame, learner, params)
+        for j, g in enumerate(gaits):
+            m = fb.motion(g, frequency_hz)
+            boots[b, j] = [getattr(m, key) for key in MOTION_KEYS]
+    out = []
+    for j, (g, m) in enumerate(zip(gaits, points, strict=True)):
+        interval = {}
+        if n_boot:
+            lo, hi = np.percentile(boots[:, j], [2.5, 97.5], axis=0)
+            interval = {
+                key: [round(float(lo[i]), 4), round(float(hi[i]), 4)]
+                for i, key in enumerate(MOTION_KEYS)
+            }
+        out.append(GaitPrediction(g, frequency_hz, learner, m, interval, n_boot))
+    return out
+
+
+def predict_gait(
+    store,
+    prep,
+    learner: str,
+    gait: Gait,
+    frequency_hz: float,
+    trials: Sequence[int] | None = None,
+    n_boot: int = 10,
+    params: dict | None = None,
+) -> GaitPrediction:
+    """`gait predict`: fit ``learner`` on version ``prep``'s trials (all by default) and
+    predict ``gait`` at frequency_hz; the bootstrap's seeds derive from the request."""
+    version = get_version(store, prep)
+    samples = version.samples(trials)
+    if samples.empty:
+        raise ConfigError(f"trials {trials}: no samples in version {version.name}", param="trials")
+    seed = derive_seed("gait-predict", version.id, learner, gait.name, frequency_hz, trials)
+    return predict_gaits(samples, [gait], frequency_hz, learner, params, n_boot, seed)[0]

@@ -1,0 +1,184 @@
+"""Predict, design (and verify) through the CLI on a small simulated dataset; the stored
+iterations; bad input leaves the database unchanged."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cli import app
+from suds_exp.gait.shape import ellipse, paper_gaits
+from suds_exp.gait.truth import simulate_forward
+from suds_exp.store import Store
+from tests.conftest import assert_same_db, dump_db
+
+runner = CliRunner()
+
+
+def ok(*args: str) -> str:
+    r = runner.invoke(app, list(args))
+    assert r.exit_code == 0, r.output + (r.stderr or "")
+    return r.stdout
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory) -> Path:
+    """O and D+ at 1/2 Hz, 2 repeats of 6 cycles, ingested and preprocessed."""
+    work = tmp_path_factory.mktemp("gait-small")
+    db = work / "small.duckdb"
+    ok(
+        "simulate",
+        "--out",
+        str(work / "d"),
+        "--gaits",
+        "O,D+",
+        "--freqs",
+        "1/2",
+        "--repeats",
+        "2",
+        "--cycles",
+        "6",
+        "--ingest",
+        "--db",
+        str(db),
+        "-q",
+    )
+    ok("preprocess", "--db", str(db), "-q")
+    return db
+
+
+@pytest.fixture
+def db(small, tmp_path) -> Path:
+    copy = tmp_path / "db.duckdb"
+    shutil.copy(small, copy)
+    return copy
+
+
+def test_the_simulator_reproduces_the_issue_figures():
+    # nominal robot, gait followed exactly at 1/2 Hz, mean of cycles 3-5 (issue 31)
+    gaits = paper_gaits() + [ellipse(1.2, 1.2), ellipse(1.2, 1.2, 0.5)]
+    got = simulate_forward(gaits, 0.5)
+    np.testing.assert_allclose(got, [23.9, 27.9, 24.3, 22.7, 30.6, 32.5, 54.4], atol=0.051)
+
+
+def test_predict_json_has_the_motion_keys_and_an_interval(db, tmp_path):
+    g = tmp_path / "circle.toml"
+    g.write_text(ellipse(1.0, 1.0, name="c").to_toml())
+    doc = json.loads(
+        ok(
+            "gait",
+            "predict",
+            "--gait-file",
+            str(g),
+            "--freq",
+            "1/2",
+            "--boot",
+            "2",
+            "--db",
+            str(db),
+            "--json",
+        )
+    )
+    for key in ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s"):
+        assert np.isfinite(doc[key])
+        lo, hi = doc["interval"][key]
+        assert lo <= hi
+    # the circle O is a training gait here: the prediction is near the simulator's
+    assert doc["forward_mm"] == pytest.approx(simulate_forward(paper_gaits()[2:3])[0], rel=0.25)
+
+
+def test_design_with_verify_stores_every_iteration_and_adds_trials(db, tmp_path):
+    before = Store(db).query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0]
+    doc = json.loads(
+        ok(
+            "gait",
+            "design",
+            "--bound",
+            "1.3",
+            "--iterations",
+            "2",
+            "--verify",
+            "--order",
+            "1",
+            "--out",
+            str(tmp_path / "out"),
+            "--db",
+            str(db),
+            "--json",
+        )
+    )
+    its = doc["iterations"]
+    assert [it["iteration"] for it in its] == [1, 2]
+    for it in its:
+        assert len(it["phase_rad"]) == len(it["phi1_rad"]) == len(it["phi2_rad"]) > 10
+        assert max(np.abs(it["phi1_rad"]).max(), np.abs(it["phi2_rad"]).max()) <= 1.3
+        for part in ("predicted", "achieved"):
+            assert set(it[part]) == {"forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s"}
+    stored = Store(db).query_df(
+        "SELECT * FROM gait_design_iterations WHERE design_id = ? ORDER BY iteration",
+        [doc["design_id"]],
+    )
+    assert len(stored) == 2 and stored["trial_id"].notna().all()
+    np.testing.assert_allclose(
+        stored["achieved_forward_mm"], [it["achieved"]["forward_mm"] for it in its], atol=1e-3
+    )
+    after = Store(db).query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0]
+    assert after == before + 2
+    # the verify trials are preprocessed into the same (only) version
+    n_versions = Store(db).query_df("SELECT count(*) AS n FROM prep_versions")["n"].iloc[0]
+    assert n_versions == 1
+    assert (Path(doc["report"])).is_file()
+
+
+def test_design_without_verify_changes_no_trials(db, tmp_path):
+    doc = json.loads(
+        ok(
+            "gait",
+            "design",
+            "--iterations",
+            "1",
+            "--order",
+            "1",
+            "--out",
+            str(tmp_path / "o"),
+            "--db",
+            str(db),
+            "--json",
+        )
+    )
+    assert "achieved" not in doc["iterations"][0]
+    assert Store(db).query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0] == 4
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["gait", "design", "--learner", "NoSuchLearner"],
+        ["gait", "predict", "--learner", "NoSuchLearner", "--gait-file", "G"],
+        ["gait", "design", "--bound", "-1"],
+    ],
+    ids=["design-learner", "predict-learner", "design-bound"],
+)
+def test_bad_options_are_one_line_and_leave_the_db_unchanged(db, tmp_path, args):
+    g = tmp_path / "g.toml"
+    g.write_text(ellipse(1.0, 1.0).to_toml())
+    args = [str(g) if a == "G" else a for a in args]
+    before = dump_db(db)
+    r = runner.invoke(
+        app,
+        [
+            *args,
+            "--out" if args[1] == "design" else "--freq",
+            str(tmp_path / "o") if args[1] == "design" else "0.5",
+            "--db",
+            str(db),
+        ],
+    )
+    assert r.exit_code == 2, r.output
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert_same_db(before, dump_db(db))
