@@ -52,6 +52,8 @@ def worker(cycles: int, repeats: int, n_jobs: int) -> dict:
     """{learner: [median CPU s per job, sha256 of its predictions]} in this process."""
     from threadpoolctl import threadpool_limits
 
+    import suds_exp  # first: campaign.py puts the working tree on sys.path
+
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import campaign as cb
 
@@ -72,7 +74,7 @@ def worker(cycles: int, repeats: int, n_jobs: int) -> dict:
         )
         if len(jobs) == n_jobs:
             break
-    out = {}
+    out = {"suds_exp": [0.0, suds_exp.__file__]}
     with threadpool_limits(limits=1):
         for name, params in CASES:
             h = hashlib.sha256()
@@ -126,6 +128,7 @@ def main(argv=None) -> int:
         f"{a.jobs} draws x {a.repeats} repeats a worker, {a.rounds} rounds; "
         f"baseline {a.baseline}, now = working tree"
     )
+    print(f"baseline from {base[0].pop('suds_exp')[1]}, now from {now[0].pop('suds_exp')[1]}")
     print("| learner | baseline s | now s | speed-up (median [min, max]) | predictions |")
     print("|---|---|---|---|---|")
     for key in base[0]:
