@@ -1,5 +1,7 @@
 # Two set-up commands for a fresh machine: `make demo` and `make test`.
-# Each creates .venv and installs the package (with its test extras) when it is not there.
+# Each creates .venv and installs the package (with its test extras) when it is not there;
+# installing also compiles the simulator's numba kernels into their on-disk cache, so no
+# first run pays that.
 PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -11,13 +13,15 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m suds_exp.sim.precompile
 	touch $(STAMP)
 
 demo: $(STAMP)
 	$(BIN)/suds-exp demo
 
+# two worker processes, each test file on one of them (its module fixtures built once)
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 # The slow suite screenshots the report with a headless browser; Debian's chromium is
 # installed here (never in `make test`) when apt-get is usable, else that test skips.

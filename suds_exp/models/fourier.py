@@ -30,12 +30,17 @@ def basis(phase: np.ndarray, order: int) -> np.ndarray:
 
 def basis_derivative(phase: np.ndarray, order: int) -> np.ndarray:
     """d/d(phase) of `basis(phase, order)`, shape (n, 2 * order + 1), per rad."""
-    phase = np.asarray(phase, dtype=float)
+    return derivative_of_basis(basis(phase, order))
+
+
+def derivative_of_basis(F: np.ndarray) -> np.ndarray:
+    """d/d(phase) of a basis F = `basis(phase, order)` (n, 2 * order + 1), from its own
+    sines and cosines (the same values as `basis_derivative`, without new ones)."""
+    order = (F.shape[1] - 1) // 2
     m = np.arange(1, order + 1)
-    arg = phase[:, None] * m[None, :]
-    out = np.zeros((len(phase), 2 * order + 1))
-    out[:, 1::2] = -m * np.sin(arg)
-    out[:, 2::2] = m * np.cos(arg)
+    out = np.zeros_like(F)
+    out[:, 1::2] = -m * F[:, 2::2]
+    out[:, 2::2] = m * F[:, 1::2]
     return out
 
 
@@ -46,7 +51,12 @@ def fit(phase: np.ndarray, values: np.ndarray, order: int, ridge: float = 1e-9) 
     values ~ basis(phase, order) @ W. `ridge` (relative to the mean diagonal of the
     normal matrix) keeps the solve defined when the phases do not cover the circle.
     """
-    F = basis(phase, order)
+    return fit_basis(basis(phase, order), values, ridge)
+
+
+def fit_basis(F: np.ndarray, values: np.ndarray, ridge: float = 1e-9) -> np.ndarray:
+    """`fit` on a basis F = `basis(phase, order)` already built (n, 2 * order + 1), so
+    a learner fitting several quantities over one phase builds it once."""
     G = F.T @ F
     G[np.diag_indices_from(G)] += ridge * np.trace(G) / len(G)
     return np.linalg.solve(G, F.T @ np.asarray(values, dtype=float).reshape(len(F), -1))

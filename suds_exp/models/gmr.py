@@ -99,7 +99,13 @@ from suds_exp.models.base import (
     require_columns,
     rollout_bounds,
 )
-from suds_exp.models.mixture import Conditional, fit_mixture, responsibilities
+from suds_exp.models.mixture import (
+    Conditional,
+    exp_inplace,
+    fit_mixture,
+    responsibilities,
+    row_max,
+)
 
 
 def history_features(
@@ -133,7 +139,7 @@ def forward_filter(log_emit, transition, priors, first) -> np.ndarray:
     log_emit (n, K): log N(x_t | component k); transition (K, K), rows sum to 1;
     priors (K,); first (n,) bool marks the first sample of each trial (restart).
     """
-    e = np.exp(log_emit - log_emit.max(axis=1, keepdims=True))
+    e = exp_inplace(log_emit - row_max(log_emit)[:, None])
     out = np.empty_like(e)
     a = priors
     for t in range(len(e)):
@@ -364,8 +370,9 @@ class GMR(Learner):
             return forward_filter(
                 lg - np.log(self.priors_), self.transition_, self.priors_, ts.first
             )
-        h = np.exp(lg - lg.max(axis=1, keepdims=True))
-        return h / h.sum(axis=1, keepdims=True)
+        h = exp_inplace(lg - row_max(lg)[:, None])
+        h /= h.sum(axis=1, keepdims=True)
+        return h
 
     def _predict_measured(self, samples):
         Xin, f = self._inputs(samples)

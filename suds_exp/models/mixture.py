@@ -13,6 +13,27 @@ import numpy as np
 from suds_exp.models.base import ModelError
 
 _LOG_2PI = np.log(2.0 * np.pi)
+# exp(x) is exactly +0.0 for every double x below this (exp(-745.14) already is)
+_EXP_ZERO_BELOW = -746.0
+# below this exp(x) is subnormal or zero, where numpy's vectorised exp is some 30x slower
+_EXP_SUBNORMAL = -708.0
+
+
+def exp_inplace(a: np.ndarray) -> np.ndarray:
+    """np.exp(a) written into `a` (any shape), bit for bit np.exp's values, fast also
+    when many entries lie far below -708.
+
+    Log-probabilities shifted by their maximum (EM responsibilities, gates of separated
+    components) are often below -745, where the exponential underflows to 0 but numpy
+    leaves its vectorised path; those entries are set to 0 directly.
+    """
+    if a.size and a.min() < _EXP_SUBNORMAL:
+        zero = a < _EXP_ZERO_BELOW
+        a[zero] = 0.0
+        np.exp(a, out=a)
+        a[zero] = 0.0
+        return a
+    return np.exp(a, out=a)
 
 
 @dataclass
@@ -61,9 +82,27 @@ def log_gaussians(X: np.ndarray, means: np.ndarray, cov: np.ndarray) -> np.ndarr
     return -0.5 * (X.shape[1] * _LOG_2PI + maha) + logdet
 
 
+def row_max(a: np.ndarray) -> np.ndarray:
+    """a.max(axis=1) of a (n_samples, K) array, same values, about 4x faster.
+
+    numpy reduces a short last axis row by row; the transposed copy makes it one
+    elementwise maximum across K contiguous rows (max is exact, so the bits agree).
+    """
+    return a.T.copy().max(axis=0)
+
+
 def _logsumexp(a: np.ndarray) -> np.ndarray:
-    m = a.max(axis=1, keepdims=True)
-    return (m + np.log(np.exp(a - m).sum(axis=1, keepdims=True)))[:, 0]
+    """log sum_k exp(a_nk), shape (n_samples,), for a of shape (n_samples, K).
+
+    The same operations in the same order as the textbook form (max, shift, exp, sum,
+    log, add back), done in place: the bits are those of that form.
+    """
+    m = row_max(a)
+    e = exp_inplace(a - m[:, None])
+    s = e.sum(axis=1)
+    np.log(s, out=s)
+    s += m
+    return s
 
 
 def _draw(weights: np.ndarray, rng) -> int:
@@ -120,9 +159,19 @@ class _Moments:
         lam = prec[:, self.iu[0], self.iu[1]] * self.offdiag
         b = np.einsum("kij,kj->ki", prec, means)
         c = (means * b).sum(1)
-        maha = self.X2 @ lam.T - 2.0 * (self.X @ b.T) + c
+        # -0.5 (D log 2 pi + max(X2 lam - 2 X b + c, 0)) - logdet, operation by operation
+        # in place (the EM's inner loop: each temporary of (n_samples, K) costs as much
+        # as the arithmetic)
+        maha = self.X2 @ lam.T
+        xb = self.X @ b.T
+        xb *= 2.0
+        maha -= xb
+        maha += c
         np.maximum(maha, 0.0, out=maha)
-        return -0.5 * (D * _LOG_2PI + maha) - logdet
+        maha += D * _LOG_2PI
+        maha *= -0.5
+        maha -= logdet
+        return maha
 
     def m_step(self, rw, reg_covar):
         """Priors, means, covariances from weighted responsibilities rw (n_samples, K)."""
@@ -162,6 +211,8 @@ def fit_mixture(
             "give more data or fewer components"
         )
     w = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
+    # multiplying by a weight of exactly 1 changes nothing: skip it when all are 1
+    unit = bool((w == 1.0).all())
     mom = _Moments(X)
     labels = kmeans_pp(X, w, n_components, rng)
     resp = np.zeros((n, n_components))
@@ -173,11 +224,14 @@ def fit_mixture(
     it = 0
     while it < max_iter:
         it += 1
-        logp = mom.log_gaussians(means, cov) + np.log(priors)
+        logp = mom.log_gaussians(means, cov)
+        logp += np.log(priors)
         norm = _logsumexp(logp)
         ll = float(w @ norm / wsum)
-        resp = np.exp(logp - norm[:, None])
-        priors, means, cov = mom.m_step(resp * w[:, None], reg_covar)
+        # resp = exp(logp - norm), in place
+        logp -= norm[:, None]
+        resp = exp_inplace(logp)
+        priors, means, cov = mom.m_step(resp if unit else resp * w[:, None], reg_covar)
         if abs(ll - ll_old) < tol:
             converged = True
             break
@@ -188,7 +242,8 @@ def fit_mixture(
 def responsibilities(X: np.ndarray, mix: Mixture) -> np.ndarray:
     """Posterior component probabilities on the full joint space, (n_samples, K)."""
     logp = log_gaussians(X, mix.means, mix.covariances) + np.log(mix.priors)
-    return np.exp(logp - _logsumexp(logp)[:, None])
+    logp -= _logsumexp(logp)[:, None]
+    return exp_inplace(logp)
 
 
 @dataclass
@@ -233,7 +288,7 @@ class Conditional:
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Responsibility-weighted conditional mean E[y | x], shape (n_samples, q)."""
         g = self.log_gate(X)
-        h = np.exp(g - g.max(axis=1, keepdims=True))
+        h = exp_inplace(g - row_max(g)[:, None])
         h /= h.sum(axis=1, keepdims=True)
         return np.einsum("nk,nkq->nq", h, self.local_means(X))
 

@@ -224,12 +224,12 @@ class TLS(Learner):
             )
 
     # -- shared pieces -----------------------------------------------------------------
-    def _offsets(self, samples, r, dra):
-        """delta (n, n_r) and delta_dot_a (n, m) from the mean gait."""
-        phase = samples["phase"].to_numpy(dtype=float)
-        rbar = fourier.basis(phase, self.gait_order) @ self.gait_coef_
+    def _offsets(self, samples, r, dra, F):
+        """delta (n, n_r) and delta_dot_a (n, m) from the mean gait; F (n, 2 gait_order
+        + 1) the Fourier basis at the samples' phases."""
+        rbar = F @ self.gait_coef_
         m = len(self.ra_columns_)
-        drbar_a = fourier.basis_derivative(phase, self.gait_order) @ self.gait_coef_[:, :m]
+        drbar_a = fourier.derivative_of_basis(F) @ self.gait_coef_[:, :m]
         return r - rbar, dra - drbar_a * phase_rate(samples)[:, None]
 
     def _coef_at(self, phase):
@@ -270,13 +270,14 @@ class TLS(Learner):
         self.rp_columns_, self.drp_columns_ = rp_cols, drp_cols
         self.ra_columns_, self.dra_columns_ = ra_cols, dra_cols
 
-        self.gait_coef_ = fourier.fit(phase, r, self.gait_order)
+        F = fourier.basis(phase, self.gait_order)  # built once, used four times
+        self.gait_coef_ = fourier.fit_basis(F, r)
         # The phase mean of the outputs (order gait_order) is taken out before binning,
         # so a bin's window only has to carry the residual's drift, not C's curvature.
-        self.mean_coef_ = fourier.fit(phase, Y, self.gait_order)
+        self.mean_coef_ = fourier.fit_basis(F, Y)
         sy = Y.std(axis=0)  # outputs, like the regressors, scaled by their whole excursion
-        Y = Y - fourier.basis(phase, self.gait_order) @ self.mean_coef_
-        delta, ddot = self._offsets(samples, r, dra)
+        Y = Y - F @ self.mean_coef_
+        delta, ddot = self._offsets(samples, r, dra, F)
         X = _features(delta, ddot)
         n, p = X.shape
         q = Y.shape[1]
@@ -337,12 +338,17 @@ class TLS(Learner):
         r = as_array(samples, ra + self.rp_columns_, self.name)
         return r, as_array(samples, dra, self.name)
 
-    def _predict_measured(self, samples, r, dra):
-        delta, ddot = self._offsets(samples, r, dra)
-        X1 = np.hstack([np.ones((len(r), 1)), _features(delta, ddot)])
-        th = self._coef_at(samples["phase"].to_numpy(dtype=float))
+    def _phase_terms(self, samples):
+        """What a prediction needs of the samples' phases alone: (the Fourier basis
+        (n, 2 gait_order + 1), the coefficients there (n, 1 + n_regressors, n_outputs))."""
         phase = samples["phase"].to_numpy(dtype=float)
-        mean = fourier.basis(phase, self.gait_order) @ self.mean_coef_
+        return fourier.basis(phase, self.gait_order), self._coef_at(phase)
+
+    def _predict_measured(self, samples, r, dra, terms=None):
+        F, th = self._phase_terms(samples) if terms is None else terms
+        delta, ddot = self._offsets(samples, r, dra, F)
+        X1 = np.hstack([np.ones((len(r), 1)), _features(delta, ddot)])
+        mean = F @ self.mean_coef_
         return mean + np.einsum("np,npq->nq", X1, th)
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
@@ -422,13 +428,14 @@ class TLSSuds(TLS):
         n, m = len(r), len(self.ra_columns_)
         r0 = r.copy()
         r0[:, m:] = 0.0
-        base = self._predict_measured(samples, r0, dra)[:, 3:]  # dr_p/dt at r_p = 0
+        terms = self._phase_terms(samples)
+        base = self._predict_measured(samples, r0, dra, terms)[:, 3:]  # dr_p/dt at r_p = 0
         # Columns of M: response of dr_p/dt to a unit r_p_i, got by linearity in r_p.
         M = np.empty((n, k, k))
         for i in range(k):
             ri = r0.copy()
             ri[:, m + i] = 1.0
-            M[:, :, i] = self._predict_measured(samples, ri, dra)[:, 3:] - base
+            M[:, :, i] = self._predict_measured(samples, ri, dra, terms)[:, 3:] - base
         ts = TimeSeries.of(samples)
         o = ts.order
         a, M, dt = base[o], M[o], ts.dt

@@ -1,0 +1,124 @@
+"""Record every learner's outputs on a fixed data set, or compare them with a record.
+
+The guard of the speed work: an optimisation must leave each learner's fitted
+predictions as they were (bit-identical where the arithmetic is unchanged).
+
+Usage (from the repository root)::
+
+    .venv/bin/python benchmarks/learner_outputs.py --save /tmp/before.npz
+    # ... change a learner ...
+    .venv/bin/python benchmarks/learner_outputs.py --compare /tmp/before.npz
+
+Data: the closed-form synthetic swimmer (`suds_exp.testing.synthetic_swimmer`,
+passive="travel", velocity="finsler", seeds fixed), 30 training cycles of O at 1/2 Hz
+(with the training trial split in two so per-trial code paths run), tested on a
+different trial of O at 1/2 Hz, of O at 1 Hz and of D+ at 1/2 Hz. Each learner of
+`MODELS`, the survey's baselines, the SUDS learners' rollout mode and the A-GBR
+variants (dilation, filter, history, BIC) are fitted once; the record holds every
+prediction array, keyed by learner and test trial. `--compare` prints, per array, the
+largest absolute difference and whether the bits are equal; exit status 1 if any
+array differs by more than `--tol` (default 0: bit-identical).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.models import make_model
+from suds_exp.testing.synthetic_swimmer import make_samples
+
+CASES = [
+    ("phase-only", {}),
+    ("TLS", {}),
+    ("TLS+SUDS", {}),
+    ("TLS+SUDS", {"mode": "rollout"}),
+    ("GMR", {}),
+    ("GMR+SUDS", {}),
+    ("GMR+SUDS", {"mode": "rollout"}),
+    ("GMR", {"augment": "dilation"}),
+    ("GMR", {"augment": "none", "branching": "filter"}),
+    ("GMR+SUDS", {"branching": "history"}),
+    ("GMR+SUDS", {"branching": "filter", "mode": "rollout"}),
+    ("GMR", {"select_k": "bic", "k_candidates": (4, 8)}),
+    ("MLP", {"random_state": 0}),
+    ("MLP+SUDS", {"random_state": 0}),
+    ("MLP+SUDS", {"random_state": 0, "mode": "rollout"}),
+    ("GBT", {"random_state": 0}),
+    ("kNN", {}),
+    ("KRR", {"random_state": 0}),
+]
+
+
+def _samples(n_cycles, gait, f, seed, tid):
+    return make_samples(
+        n_cycles,
+        gait=gait,
+        frequency_hz=f,
+        passive="travel",
+        velocity="finsler",
+        noise_r=0.005,
+        noise_dr=0.05,
+        seed=seed,
+        first_trial_id=tid,
+    )
+
+
+def data():
+    """(training frame of two trials, {test name: frame})."""
+    train = pd.concat([_samples(15, "O", 0.5, 11, 1), _samples(15, "O", 0.5, 12, 2)])
+    train = train.reset_index(drop=True)
+    tests = {
+        "O@0.5": _samples(10, "O", 0.5, 13, 3),
+        "O@1": _samples(10, "O", 1.0, 14, 4),
+        "D+@0.5": _samples(10, "D+", 0.5, 15, 5),
+    }
+    return train, tests
+
+
+def record() -> dict[str, np.ndarray]:
+    train, tests = data()
+    out = {}
+    for name, params in CASES:
+        m = make_model(name, **params).fit(train)
+        label = name + "".join(f" {k}={v}" for k, v in sorted(params.items()))
+        for tname, test in tests.items():
+            out[f"{label} | {tname}"] = m.predict(test).to_numpy(dtype=float)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    g = ap.add_mutually_exclusive_group(required=True)
+    g.add_argument("--save", help="write the record to this .npz file")
+    g.add_argument("--compare", help="compare with the record in this .npz file")
+    ap.add_argument("--tol", type=float, default=0.0, help="largest absolute difference allowed")
+    a = ap.parse_args(argv)
+    now = record()
+    if a.save:
+        np.savez(a.save, **now)
+        print(f"recorded {len(now)} prediction arrays in {a.save}")
+        return 0
+    old = dict(np.load(a.compare))
+    bad = 0
+    for key in sorted(set(old) | set(now)):
+        if key not in old or key not in now:
+            print(f"MISSING {key}")
+            bad += 1
+            continue
+        same = old[key].shape == now[key].shape and np.array_equal(
+            old[key].view(np.uint64), now[key].view(np.uint64)
+        )
+        diff = float(np.nanmax(np.abs(old[key] - now[key]))) if not same else 0.0
+        ok = same or diff <= a.tol
+        bad += not ok
+        print(f"{'bit-identical' if same else f'max |diff| {diff:.3g}':>22}  {key}")
+    print(f"{len(now) - bad} of {len(set(old) | set(now))} arrays within tol={a.tol}")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,147 @@
+"""Learner fit + predict time against a baseline commit, on the same data, same run.
+
+Usage (from the repository root)::
+
+    .venv/bin/python benchmarks/learner_speed.py [--baseline c2aa7be] [--rounds 5]
+        [--repeats 5] [--cycles 30]
+
+The baseline's `suds_exp` is exported from git (`git archive`) into a temporary folder;
+rounds alternate a worker process on the baseline and one on the working tree (A B A B
+...), so a change in the machine's load hits both. Each worker fits and predicts every
+learner `--repeats` times, single-threaded BLAS (the campaign runs one job a core), on the
+campaign benchmark's synthetic data (`benchmarks/campaign.py`, 5 gaits x 3 frequencies x
+4 trials, 100 samples a cycle): the first bootstrap draws of its small grid at
+`--cycles` training cycles, predicting a different trial of the test condition. It
+reports the median CPU seconds of one job (fit + predict) per learner; the table gives
+the medians over rounds and the ratio baseline / now per round (its median, min, max).
+Each worker also hashes every prediction, so the table says whether the working tree's
+predictions are bit-identical to the baseline's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import tarfile
+import tempfile
+import time
+from io import BytesIO
+from pathlib import Path
+from statistics import median
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = [
+    ("phase-only", {}),
+    ("TLS", {}),
+    ("TLS+SUDS", {}),
+    ("GMR", {}),
+    ("GMR+SUDS", {}),
+    ("GMR+SUDS", {"mode": "rollout"}),
+]
+
+
+def _label(name, params):
+    return name + "".join(f" {k}={v}" for k, v in sorted(params.items()))
+
+
+def worker(cycles: int, repeats: int, n_jobs: int) -> dict:
+    """{learner: [median CPU s per job, sha256 of its predictions]} in this process."""
+    from threadpoolctl import threadpool_limits
+
+    import suds_exp  # first: campaign.py puts the working tree on sys.path
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import campaign as cb
+
+    from suds_exp.campaign import SampleBank, enumerate_draws
+    from suds_exp.campaign.bank import rounded_conditions
+    from suds_exp.campaign.conditions import select_conditions
+    from suds_exp.campaign.sampling import draw_sample
+    from suds_exp.models import make_model
+
+    samples = cb.paper_like_samples()
+    chosen = select_conditions(cb.SMALL, rounded_conditions(samples), "--x")
+    bank = SampleBank.build(samples, chosen)
+    jobs = []
+    for d in enumerate_draws("bench", chosen, chosen, 1, cycles, []):
+        s = draw_sample(bank, d, cycles)
+        jobs.append(
+            (bank.frame([bank.rows(*r) for r in s.train]), bank.frame([bank.rows(*s.test)]))
+        )
+        if len(jobs) == n_jobs:
+            break
+    out = {"suds_exp": [0.0, suds_exp.__file__]}
+    with threadpool_limits(limits=1):
+        for name, params in CASES:
+            h = hashlib.sha256()
+            per_job = []
+            for _ in range(repeats):
+                c0 = time.process_time()
+                for train, test in jobs:
+                    p = make_model(name, **params).fit(train).predict(test)
+                    h.update(p.to_numpy(dtype=float).tobytes())
+                per_job.append((time.process_time() - c0) / len(jobs))
+            out[_label(name, params)] = [median(per_job), h.hexdigest()[:16]]
+    return out
+
+
+def _export(commit: str, folder: Path) -> None:
+    data = subprocess.run(
+        ["git", "archive", commit, "suds_exp"], cwd=ROOT, check=True, capture_output=True
+    ).stdout
+    with tarfile.open(fileobj=BytesIO(data)) as tar:
+        tar.extractall(folder, filter="data")
+
+
+def _run(path: Path, a) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
+    cmd = [sys.executable, __file__, "--worker", "--cycles", str(a.cycles)]
+    cmd += ["--repeats", str(a.repeats), "--jobs", str(a.jobs)]
+    res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
+    return json.loads(res.stdout.splitlines()[-1])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--baseline", default="c2aa7be")
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--cycles", type=int, default=30)
+    ap.add_argument("--jobs", type=int, default=4, help="bootstrap draws per learner")
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.worker:
+        print(json.dumps(worker(a.cycles, a.repeats, a.jobs)))
+        return 0
+    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
+        _export(a.baseline, Path(tmp))
+        base, now = [], []
+        for _ in range(a.rounds):
+            base.append(_run(Path(tmp), a))
+            now.append(_run(ROOT, a))
+    print(
+        f"## Learner CPU seconds per job (fit + predict), {a.cycles} training cycles, "
+        f"{a.jobs} draws x {a.repeats} repeats a worker, {a.rounds} rounds; "
+        f"baseline {a.baseline}, now = working tree"
+    )
+    print(f"baseline from {base[0].pop('suds_exp')[1]}, now from {now[0].pop('suds_exp')[1]}")
+    print("| learner | baseline s | now s | speed-up (median [min, max]) | predictions |")
+    print("|---|---|---|---|---|")
+    for key in base[0]:
+        b = [r[key][0] for r in base]
+        n = [r[key][0] for r in now]
+        ratios = sorted(x / y for x, y in zip(b, n, strict=True))
+        same = all(r[key][1] == base[0][key][1] for r in base + now)
+        print(
+            f"| {key} | {median(b):.4f} | {median(n):.4f} | {median(ratios):.2f}x "
+            f"[{ratios[0]:.2f}, {ratios[-1]:.2f}] | {'bit-identical' if same else 'DIFFER'} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
