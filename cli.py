@@ -80,6 +80,14 @@ def command(*args, flags: dict[str, str] | None = None, **kwargs):
                     f"[red]error:[/red] {user_message(exc, flags)}", markup=True, highlight=False
                 )
                 raise typer.Exit(2) from None
+            except KeyboardInterrupt:
+                # every write is one transaction: what was stored stays, nothing is half
+                console.err.print(
+                    "stopped (Ctrl-C): what was stored is kept; run the same command again "
+                    "to continue",
+                    highlight=False,
+                )
+                raise typer.Exit(130) from None
 
         return app.command(*args, **kwargs)(run)
 
@@ -700,7 +708,7 @@ def stream(
     ] = None,
     warmup: Annotated[int, typer.Option(help="Cycles that train before scoring starts.")] = 10,
     change_at: Annotated[
-        float | None,
+        str | None,
         typer.Option(help="Change time (s) of every trial (default: the simulator's schedule)."),
     ] = None,
     plot: Annotated[
@@ -719,9 +727,12 @@ def stream(
     bed --models GMR,OnlineGMR --plot reports/bed.png
     """
     from suds_exp.preprocess import parse_trial_ids
+    from suds_exp.store.files import check_writable
     from suds_exp.stream import StreamSettings, plot_error, run_stream, stream_rows, summarise
 
     store = open_store(db)
+    if plot is not None:  # before any row is stored
+        check_writable(plot.parent, "plot: folder", param="plot")
     run = run_stream(
         store,
         name,
