@@ -31,6 +31,7 @@ import datetime as dt
 import hashlib
 import itertools
 import os
+import random
 import shutil
 import signal
 import subprocess
@@ -411,13 +412,31 @@ def probe_ctrl_c(data: Data) -> Tally:
         while len(descendants(p.pid)) < 2 and time.perf_counter() < deadline:
             time.sleep(0.2)
         time.sleep(2.0)
-        os.killpg(p.pid, signal.SIGINT)
-        r = finish(p, t)
+        r, presses = ctrl_c(p, t)
         lines = [x for x in (r.stdout + r.stderr).splitlines() if x.strip()]
         ok = r.code == 130 and not r.traceback and len(lines) == 1 and "stopped" in lines[0]
         tally.add(ok, f"{backend}: rc {r.code}, {len(lines)} lines: {(r.stdout + r.stderr)[-400:]}")
-        print(f"  Ctrl-C {backend}: rc {r.code}, {len(lines)} line(s): {lines[:1]}", flush=True)
+        print(
+            f"  Ctrl-C {backend} ({presses} press{'es' if presses > 1 else ''}): rc {r.code}, "
+            f"{len(lines)} line(s): {lines[:1]}",
+            flush=True,
+        )
     return tally
+
+
+def ctrl_c(p: subprocess.Popen, started: float, again_s: float = 8.0) -> tuple[Outcome, int]:
+    """SIGINT to ``p``'s process group, as a terminal's Ctrl-C; pressed again when the
+    process still runs ``again_s`` s later (a Ctrl-C while workers start may be lost:
+    see `suds_exp.campaign.runner._sigint_blocked`). Returns the outcome and the presses."""
+    presses = 0
+    while True:
+        os.killpg(p.pid, signal.SIGINT)
+        presses += 1
+        try:
+            p.wait(timeout=again_s)
+        except subprocess.TimeoutExpired:
+            continue
+        return finish(p, started), presses
 
 
 def _damaged_copies(data: Data, folder: Path) -> dict[str, Path]:
@@ -434,7 +453,8 @@ def _damaged_copies(data: Data, folder: Path) -> dict[str, Path]:
     block = used[len(used) // 2]
     at = HEADER_BYTES + block * size + size // 2
     bad = bytearray(raw)
-    bad[at : at + 64] = bytes(64)
+    # random bytes (flipping zeros would cancel out in DuckDB's xor-of-words checksum)
+    bad[at : at + 64] = random.Random(block).randbytes(64)
     corrupt = folder / "corrupt.duckdb"
     corrupt.write_bytes(bytes(bad))
     return {"cut at a 4 KiB boundary": cut, "a corrupted block": corrupt}

@@ -421,8 +421,8 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
         if scheduler:
             stack.enter_context(Client(scheduler, timeout=SCHEDULER_WAIT_S))
         else:
-            cluster = stack.enter_context(
-                LocalCluster(
+            with _sigint_blocked():
+                cluster = LocalCluster(
                     n_workers=_n_workers(jobs),
                     threads_per_worker=1,
                     processes=True,
@@ -432,16 +432,18 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
                     # closing busy workers is not worth a warning on the terminal
                     silence_logs=logging.ERROR,
                 )
-            )
+            stack.enter_context(cluster)
             stack.enter_context(Client(cluster))
         # Scattered once to every worker; joblib swaps the argument for its future.
         shared = bank
         stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
     # loky workers end with this process, even after kill -9 (see `job.watch_parent`)
     worker_args = {"blas": "pin", "parent": os.getpid()} if backend == "loky" else {"blas": "block"}
-    gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
-        delayed(run_chunk)(shared, c, *args, **worker_args) for c in chunks
-    )
+    # loky starts its workers here, with SIGINT held back like dask's (`_sigint_blocked`)
+    with _sigint_blocked():
+        gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
+            delayed(run_chunk)(shared, c, *args, **worker_args) for c in chunks
+        )
     stack.callback(getattr(gen, "close", lambda: None))
     return gen
 
@@ -473,6 +475,32 @@ def _bank_folder(stack: contextlib.ExitStack) -> Path:
     lock.acquire(timeout=0)
     stack.callback(lock.release)
     return folder
+
+
+@contextlib.contextmanager
+def _sigint_blocked() -> Iterator[None]:
+    """Worker processes started inside the block ignore SIGINT for their whole life.
+
+    A terminal's Ctrl-C reaches the whole process group; only this process should act on
+    it (it stops the run and its workers). A worker hit while it starts prints a
+    traceback (and a dask cluster then fails to start), so workers are started while
+    SIGINT is ignored, which a new process inherits (a blocked mask it does not: Python's
+    process spawning resets it). This thread blocks SIGINT meanwhile, so a Ctrl-C that
+    lands on it is served when the block ends; one that the kernel hands to another
+    thread in that moment (a BLAS thread) is lost, and the user presses Ctrl-C again.
+    """
+    if not hasattr(signal, "pthread_sigmask") or (
+        threading.current_thread() is not threading.main_thread()
+    ):
+        yield
+        return
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler if old is None else old)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 @dataclass(frozen=True)

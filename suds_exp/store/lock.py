@@ -25,6 +25,7 @@ from pathlib import Path
 from filelock import FileLock, Timeout
 
 from suds_exp.errors import StoreError
+from suds_exp.store.integrity import check_file
 
 #: How long a writer waits for another one to finish before refusing, in s.
 WRITE_WAIT_S = 15.0
@@ -84,6 +85,7 @@ class WriteLock:
                     )
                 _held[self.key] = (lock, depth + 1, info)
                 return self
+        check_file(self.db)  # a damaged database is refused before a lock file is made
         path = lock_path(self.db)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)

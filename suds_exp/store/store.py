@@ -17,7 +17,7 @@ import sqlalchemy as sa
 from suds_exp.errors import StoreError
 from suds_exp.store import migrate
 from suds_exp.store.engine import default_db_path, make_engine, open_problem, retry_on_lock
-from suds_exp.store.integrity import check_file, mark_written
+from suds_exp.store.integrity import mark_written
 from suds_exp.store.lock import WriteLock
 
 _frame_names = itertools.count()
@@ -51,7 +51,6 @@ class Store:
         """The database's write lock for ``command`` (its ``name``: the campaign, stream,
         version or run), a context manager; another writer waits up to ``wait_s`` s
         (default `suds_exp.store.lock.WRITE_WAIT_S`) and is then refused in one line."""
-        check_file(self.path)  # a damaged file is refused before a lock file is made
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
