@@ -386,26 +386,19 @@ def probe_pairs(data: Data, offsets: list[float], names: list[str]) -> Tally:
     return tally
 
 
+def campaign_args(backend: str, boots: int = 12) -> list[str]:
+    """A GMR campaign of ``boots`` x 4 jobs on 2 workers of ``backend`` (loky, dask)."""
+    return ["run", "c", "--models", "GMR", "--boots", str(boots), "--train-cycles", "3",
+            "--jobs", "2", "--backend", backend]  # fmt: skip
+
+
 def probe_ctrl_c(data: Data) -> Tally:
     """SIGINT to the process group of a running campaign (a terminal's Ctrl-C)."""
     tally = Tally("Ctrl-C")
     for backend in ("loky", "dask"):
         folder = data.work / f"ctrl-c-{backend}"
         db = fresh(data.prepped, folder)
-        args = [
-            "run",
-            "c",
-            "--models",
-            "GMR",
-            "--boots",
-            "12",
-            "--train-cycles",
-            "3",
-            "--jobs",
-            "2",
-            "--backend",
-            backend,
-        ]
+        args = campaign_args(backend)
         t = time.perf_counter()
         p = start(args, db, folder)
         deadline = time.perf_counter() + 60
@@ -485,6 +478,23 @@ def read_only_mount(source: Path):
         point.rmdir()
 
 
+def every_command(data: Data, folder: Path) -> list[list[str]]:
+    """One call of every command that opens the database (reports go under ``folder``)."""
+    return [
+        ["trials"],
+        ["status", "c"],
+        ["sql", "SELECT count(*) FROM trials"],
+        ["init"],
+        ["ingest", str(data.captures), "--manifest", str(data.manifest)],
+        ["preprocess"],
+        ["run", "c", "--models", "TLS", "--boots", "1"],
+        ["stream", "s"],
+        ["discrepancy", "--out", str(folder / "dd")],
+        ["report", "c", "--out", str(folder / "rr")],
+        ["findings", "c"],
+    ]
+
+
 def probe_bad_inputs(data: Data) -> tuple[Tally, int]:
     """Refused inputs: one line, status 2, the database byte-identical (and names free)."""
     tally = Tally("bad inputs")
@@ -512,19 +522,7 @@ def probe_bad_inputs(data: Data) -> tuple[Tally, int]:
         ["ingest", str(folder / "missing.tsv")],
     ]
     cases = [(args, db) for args in refusals]
-    everyone = [
-        ["trials"],
-        ["status", "c"],
-        ["sql", "SELECT count(*) FROM trials"],
-        ["init"],
-        ["ingest", str(data.captures), "--manifest", str(data.manifest)],
-        ["preprocess"],
-        ["run", "c", "--models", "TLS", "--boots", "1"],
-        ["stream", "s"],
-        ["discrepancy", "--out", str(folder / "dd")],
-        ["report", "c", "--out", str(folder / "rr")],
-        ["findings", "c"],
-    ]
+    everyone = every_command(data, folder)
     for copy in _damaged_copies(data, folder / "damaged").values():
         cases += [(args, copy) for args in everyone]
     for args, path in cases:

@@ -186,19 +186,7 @@ def damaged(data: probe.Data, folder: Path) -> dict[str, Path]:
 def test_a_damaged_database_is_refused_by_every_command_and_never_written(data, tmp_path, kind):
     db = damaged(data, tmp_path / "damaged")[kind]
     files = sorted(p.name for p in db.parent.iterdir())
-    for args in (
-        ["trials"],
-        ["status", "c"],
-        ["sql", "SELECT count(*) FROM trials"],
-        ["init"],
-        ["ingest", str(data.captures), "--manifest", str(data.manifest)],
-        ["preprocess"],
-        ["run", "c", "--models", "TLS", "--boots", "1"],
-        ["stream", "s"],
-        ["discrepancy", "--out", str(tmp_path / "d")],
-        ["report", "c", "--out", str(tmp_path / "r")],
-        ["findings", "c"],
-    ):
+    for args in probe.every_command(data, tmp_path):
         one_line_refusal(args, db, "truncated or damaged")
     assert sorted(p.name for p in db.parent.iterdir()) == files  # not even a lock file
 
@@ -244,25 +232,8 @@ def test_a_read_only_file_system_gives_one_line_and_stores_nothing(data, tmp_pat
         one_line_refusal(args, outside, "read-only file system")
 
 
-def run_args(backend: str, boots: int = 12) -> list[str]:
-    return [
-        "run",
-        "c",
-        "--models",
-        "GMR",
-        "--boots",
-        str(boots),
-        "--train-cycles",
-        "3",
-        "--jobs",
-        "2",
-        "--backend",
-        backend,
-    ]
-
-
 def start_run(db: Path, backend: str, boots: int = 12) -> subprocess.Popen:
-    return probe.start(run_args(backend, boots), db, db.parent)
+    return probe.start(probe.campaign_args(backend, boots), db, db.parent)
 
 
 def wait_workers(p: subprocess.Popen, n: int = 2, timeout: float = 60) -> set[int]:
