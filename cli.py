@@ -80,6 +80,15 @@ def command(*args, flags: dict[str, str] | None = None, **kwargs):
                     f"[red]error:[/red] {user_message(exc, flags)}", markup=True, highlight=False
                 )
                 raise typer.Exit(2) from None
+            except OSError as exc:
+                # a file-system error the library did not foresee (disk full while a
+                # report is written...): its path and reason, not a traceback
+                where = f"{exc.filename}: " if exc.filename else ""
+                reason = (exc.strerror or str(exc)).lower()
+                console.err.print(
+                    f"[red]error:[/red] {where}{reason}", markup=True, highlight=False
+                )
+                raise typer.Exit(2) from None
             except KeyboardInterrupt:
                 # every write is one transaction: what was stored stays, nothing is half
                 console.err.print(

@@ -216,8 +216,8 @@ def kill9(p: subprocess.Popen, started: float, grace_s: float = 10.0) -> Outcome
     ``grace_s`` s, and how long the last of them took to go."""
     below = descendants(p.pid)
     os.kill(p.pid, signal.SIGKILL)
-    out, err = p.communicate()
     t0 = time.perf_counter()
+    p.wait()
     while any(_alive(c) for c in below) and time.perf_counter() - t0 < grace_s:
         time.sleep(0.1)
     left = [c for c in below if _alive(c)]
@@ -225,6 +225,8 @@ def kill9(p: subprocess.Popen, started: float, grace_s: float = 10.0) -> Outcome
     for c in left:  # not ours to leave behind
         with contextlib.suppress(OSError):
             os.kill(c, signal.SIGKILL)
+    # (returns once every process holding the pipes is gone: workers inherit them)
+    out, err = p.communicate()
     return Outcome(p.returncode, out, err, time.perf_counter() - started, len(left), gone)
 
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import struct
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -125,11 +126,38 @@ def free_blocks(path: Path, f, count: int, block_size: int, pointer: int) -> set
     return set(struct.unpack_from(f"<{n}q", data, 8))
 
 
+#: Checks of a file another process changed meanwhile (a writer's checkpoint can free
+#: and reuse blocks, or cut the file, while it is read) before a fault is believed.
+ATTEMPTS = 3
+
+
 def check_file(path: Path, blocks: bool = True) -> None:
     """Raise `Damaged` (one line naming ``path``) for an existing file that is not a
     DuckDB database, whose headers fail their checksums, that is shorter than its header
     says, or (``blocks``, once per file and process) one of whose blocks fails its
-    checksum. A missing or empty file passes (DuckDB creates it)."""
+    checksum. A missing or empty file passes (DuckDB creates it). A fault found while the
+    file changed (another process wrote it) is checked again, up to `ATTEMPTS` times."""
+    for attempt in range(ATTEMPTS):
+        try:
+            before = path.stat()
+            _check_once(path, blocks)
+            return
+        except Damaged:
+            try:
+                after = path.stat()
+            except OSError:
+                return
+            if attempt == ATTEMPTS - 1 or (before.st_size, before.st_mtime_ns) == (
+                after.st_size,
+                after.st_mtime_ns,
+            ):
+                raise
+            time.sleep(0.2)
+        except OSError:
+            return  # DuckDB's own open names the problem (no such file, permission, ...)
+
+
+def _check_once(path: Path, blocks: bool) -> None:
     try:
         if not path.is_file():
             return
