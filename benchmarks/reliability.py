@@ -354,7 +354,8 @@ def probe_kill(data: Data, moments: list[float], names: list[str]) -> tuple[Tall
 def probe_pairs(data: Data, offsets: list[float], names: list[str]) -> Tally:
     """Two writers on one database, the second started ``offset`` s after the first."""
     tally = Tally("two writers")
-    pairs = list(itertools.combinations_with_replacement(names, 2))
+    # a command with itself first: the races that stored rows twice before
+    pairs = [(n, n) for n in names] + list(itertools.combinations(names, 2))
     for (a, b), offset in itertools.product(pairs, offsets):
         cmds_a, cmds_b = data.commands("a"), data.commands("b")
         base_a, args_a = cmds_a[a]
