@@ -124,17 +124,18 @@ def run_stream(
         # Every learner's first unit is computed before anything is stored, so a learner
         # that cannot run with these settings (too short a warm-up...) is refused with
         # the database unchanged and the name still free.
-        first: dict[str, pd.DataFrame] = {}
+        first: dict[tuple[str, int], pd.DataFrame] = {}
         for tid, model, params in todo:
-            if model not in first:
-                first[model] = _unit_rows(by_trial[tid], name, model, params, settings, changes)
+            if not any(m == model for m, _ in first):
+                rows = _unit_rows(by_trial[tid], name, model, params, settings, changes)
+                first[(model, tid)] = rows
         bar = progress_bar(
             f"Stream {name}", summary.units, progress, done=summary.done_before, unit="runs"
         )
         with bar as advance:
             for tid, model, params in todo:
-                if model in first and int(first[model]["trial_id"].iloc[0]) == tid:
-                    rows = first.pop(model)
+                if (model, tid) in first:
+                    rows = first.pop((model, tid))
                 else:
                     rows = _unit_rows(by_trial[tid], name, model, params, settings, changes)
                 with store.write() as conn:
