@@ -439,8 +439,9 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
         stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
     # loky workers end with this process, even after kill -9 (see `job.watch_parent`)
     worker_args = {"blas": "pin", "parent": os.getpid()} if backend == "loky" else {"blas": "block"}
-    # loky starts its workers here, with SIGINT held back like dask's (`_sigint_blocked`)
-    with _sigint_blocked():
+    # loky starts its workers here, with SIGINT ignored like dask's (`_sigint_blocked`);
+    # dask's are up already, and this call may take a while (scatter)
+    with _sigint_blocked() if backend == "loky" else contextlib.nullcontext():
         gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
             delayed(run_chunk)(shared, c, *args, **worker_args) for c in chunks
         )
