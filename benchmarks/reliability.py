@@ -431,7 +431,7 @@ def probe_ctrl_c(data: Data) -> Tally:
     return tally
 
 
-def ctrl_c(p: subprocess.Popen, started: float, again_s: float = 8.0) -> tuple[Outcome, int]:
+def ctrl_c(p: subprocess.Popen, started: float, again_s: float = 3.0) -> tuple[Outcome, int]:
     """SIGINT to ``p``'s process group, as a terminal's Ctrl-C; pressed again when the
     process still runs ``again_s`` s later (a Ctrl-C while workers start may be lost:
     see `suds_exp.campaign.runner._sigint_blocked`). Returns the outcome and the presses."""
