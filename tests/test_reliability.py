@@ -272,12 +272,12 @@ def test_ctrl_c_to_the_process_group_of_a_loky_run_is_one_line_and_status_130(da
 
 @pytest.mark.slow
 @pytest.mark.skipif(os.name != "posix", reason="process groups")
-@pytest.mark.parametrize("after_s", [0.5, 4.0])
+@pytest.mark.parametrize("after_s", [0.5, 3.0])
 def test_ctrl_c_to_the_process_group_of_a_dask_run_is_one_line_and_status_130(
     data, tmp_path, after_s
 ):
     db = fresh(data.prepped, tmp_path)
-    p = start_run(db, "dask")
+    p = start_run(db, "dask", boots=60)  # long enough to be running at ``after_s``
     wait_workers(p, 1)
     time.sleep(after_s)  # while the cluster starts, and once it runs
     r, _ = probe.ctrl_c(p, time.perf_counter())
