@@ -82,6 +82,23 @@ def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None =
                     f"[red]error:[/red] {user_message(exc, flags)}", markup=True, highlight=False
                 )
                 raise typer.Exit(2) from None
+            except OSError as exc:
+                # a file-system error the library did not foresee (disk full while a
+                # report is written...): its path and reason, not a traceback
+                where = f"{exc.filename}: " if exc.filename else ""
+                reason = (exc.strerror or str(exc)).lower()
+                console.err.print(
+                    f"[red]error:[/red] {where}{reason}", markup=True, highlight=False
+                )
+                raise typer.Exit(2) from None
+            except KeyboardInterrupt:
+                # every write is one transaction: what was stored stays, nothing is half
+                console.err.print(
+                    "stopped (Ctrl-C): what was stored is kept; run the same command again "
+                    "to continue",
+                    highlight=False,
+                )
+                raise typer.Exit(130) from None
 
         return (on or app).command(*args, **kwargs)(run)
 
@@ -809,7 +826,7 @@ def stream(
     ] = None,
     warmup: Annotated[int, typer.Option(help="Cycles that train before scoring starts.")] = 10,
     change_at: Annotated[
-        float | None,
+        str | None,
         typer.Option(help="Change time (s) of every trial (default: the simulator's schedule)."),
     ] = None,
     plot: Annotated[
@@ -828,9 +845,12 @@ def stream(
     bed --models GMR,OnlineGMR --plot reports/bed.png
     """
     from suds_exp.preprocess import parse_trial_ids
+    from suds_exp.store.files import check_writable
     from suds_exp.stream import StreamSettings, plot_error, run_stream, stream_rows, summarise
 
     store = open_store(db)
+    if plot is not None:  # before any row is stored
+        check_writable(plot.parent, "plot: folder", param="plot")
     run = run_stream(
         store,
         name,

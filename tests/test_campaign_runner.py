@@ -21,6 +21,7 @@ from suds_exp.campaign import (
     run_campaign,
 )
 from suds_exp.campaign.lock import RunLock
+from suds_exp.errors import StoreError
 from suds_exp.store import Store
 from suds_exp.testing.demo_campaign import demo_campaign, demo_options
 from tests.test_campaign_grid import synthetic_samples
@@ -108,7 +109,7 @@ def test_a_second_run_on_the_same_database_is_refused(db, samples):
     store = Store(db)
     with (
         RunLock(db, "other"),
-        pytest.raises(CampaignError, match="another `suds-exp run`.*'other'"),
+        pytest.raises(StoreError, match="`suds-exp run` 'other' .* is writing to this database"),
     ):
         run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)

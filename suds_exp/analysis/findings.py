@@ -634,9 +634,17 @@ def findings_summary(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def findings(store, campaign: str, **kwargs) -> pd.DataFrame:
-    """`findings_table` of campaign ``campaign`` in ``store`` (keyword options as there)."""
+    """`findings_table` of campaign ``campaign`` in ``store`` (keyword options as there,
+    except that ``n_boot`` must be >= 1: a verdict needs its interval)."""
     from suds_exp.analysis.queries import load_results
 
+    n_boot = kwargs.get("n_boot", 1)
+    if isinstance(n_boot, bool) or not isinstance(n_boot, int) or n_boot < 1:
+        raise AnalysisError(
+            f"n_boot {n_boot!r}: expected an integer >= 1 (replicates of the intervals "
+            "the verdicts rest on)",
+            param="n_boot",
+        )
     return findings_table(load_results(store, campaign), campaign=campaign, **kwargs)
 
 

@@ -30,6 +30,7 @@ from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
 from suds_exp.errors import AnalysisError
 from suds_exp.store import Store
+from suds_exp.store.files import check_writable
 
 _SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -176,6 +177,7 @@ def write_report(
             )
         out_dir = Path("reports") / campaign
     out = Path(out_dir)
+    check_writable(out, "out: report folder", AnalysisError, param="out")
     results = load_results(store, campaign)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)

@@ -108,6 +108,11 @@ def _chain_tracks(conn: sa.Connection, body: Body, meta_row) -> tuple[np.ndarray
 
 
 def _preprocess_chain(store, body, name, params, trials_, progress) -> PrepResult:
+    with store.locked("preprocess", name):
+        return _locked_chain(store, body, name, params, trials_, progress)
+
+
+def _locked_chain(store, body, name, params, trials_, progress) -> PrepResult:
     started = time.perf_counter()
     given = dict(params or {})
     given["k"] = body.chain.modes - 2

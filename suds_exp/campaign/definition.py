@@ -23,7 +23,7 @@ from suds_exp.campaign.conditions import (
     select_conditions,
 )
 from suds_exp.campaign.sampling import infeasible_cells
-from suds_exp.errors import CampaignError
+from suds_exp.errors import CampaignError, ConfigError
 from suds_exp.robot import LEARNERS
 
 MODES = ("measured", "rollout")
@@ -168,6 +168,14 @@ def resolve_models(models, mode: str) -> dict[str, dict]:
         model = make_model(name, **dict(params or {}))
         if "mode" in model.get_params(deep=False):
             model.set_params(mode=mode)
+        # values are otherwise first checked by fit, in every job, after the campaign
+        # (and its name) was stored with them
+        check = getattr(model, "_validate", None)
+        try:
+            if check is not None:
+                check()
+        except ConfigError as exc:
+            raise CampaignError(f"model_params: {exc}", param="model_params") from None
         out[name] = json.loads(json.dumps(model_recipe(model), default=_json_default))
     if not out:
         raise CampaignError("models: no learner given; expected e.g. TLS,GMR", param="models")
@@ -285,24 +293,6 @@ def _conditions(value, available, option) -> list[Condition]:
 def _check_int(option: str, value, low: int) -> None:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
         raise CampaignError(f"{option}: {value!r}; expected an integer >= {low}", param=option)
-
-
-def differences(stored: dict, new: dict, prefix: str = "") -> list[str]:
-    """Human-readable ``path: old -> new`` lines for every leaf where the two differ."""
-    out: list[str] = []
-    for key in sorted(set(stored) | set(new), key=str):
-        path = f"{prefix}{key}"
-        a, b = stored.get(key, "<absent>"), new.get(key, "<absent>")
-        if isinstance(a, dict) and isinstance(b, dict):
-            out += differences(a, b, path + ".")
-        elif a != b:
-            out.append(f"{path}: {_short(a)} -> {_short(b)}")
-    return out
-
-
-def _short(value) -> str:
-    text = json.dumps(value, default=str)
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def skipped_cells_text(definition: dict) -> str:

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
+import signal
+import threading
 import time
 from datetime import UTC, datetime
 
@@ -50,6 +53,7 @@ def run_chunk(
     models: dict[str, dict],
     test_cycles: int,
     blas: str = "block",
+    parent: int | None = None,
 ) -> list[dict]:
     """Rows of every job in ``chunk`` (a list of (draw, learner names)).
 
@@ -57,9 +61,13 @@ def run_chunk(
     parent, in a loky worker and on a dask worker, and workers do not oversubscribe the
     cores. ``blas``: "block" limits it for this call (~2 ms: threadpoolctl scans the loaded
     libraries), "pin" once for the life of the process (dedicated loky workers), "none"
-    leaves it to the caller.
+    leaves it to the caller. ``parent``: in a worker process, the pid of the process that
+    runs the campaign; the worker then ends itself when that process is gone
+    (`watch_parent`) and leaves Ctrl-C to it.
     """
     global _PINNED
+    if parent is not None:
+        watch_parent(parent)
     rows: list[dict] = []
     if blas == "pin" and not _PINNED:
         threadpool_limits(limits=1)
@@ -68,6 +76,37 @@ def run_chunk(
         for draw, names in chunk:
             rows.extend(run_draw(bank, draw, names, models, test_cycles))
     return rows
+
+
+_WATCHED: set[int] = set()
+#: How often a worker checks that the campaign's process is still there, in s.
+PARENT_POLL_S = 0.5
+
+
+def watch_parent(pid: int) -> None:
+    """In a worker process of ``pid``'s campaign: ignore SIGINT (a terminal's Ctrl-C
+    reaches the whole process group; the parent stops the run and its workers) and, once
+    per process, start a daemon thread that ends this process within `PARENT_POLL_S` s of
+    ``pid`` ending (kill -9 included), instead of idling until the pool's timeout."""
+    if pid == os.getpid() or pid in _WATCHED:
+        return
+    _WATCHED.add(pid)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def watch() -> None:
+        while _alive(pid):
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="suds-watch-parent", daemon=True).start()
+
+
+def _alive(pid: int) -> bool:
+    # An orphan is re-parented, so its parent id changes when the parent dies. Windows
+    # keeps the old id (and has no cheap safe probe: os.kill terminates): there the
+    # pool's own idle timeout ends the workers.
+    return os.getppid() == pid if os.name == "posix" else True
 
 
 def run_draw(

@@ -17,8 +17,10 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import math
 import os
+import shutil
 import signal
 import socket
 import tempfile
@@ -27,6 +29,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
+from pathlib import Path
 
 import pandas as pd
 import sqlalchemy as sa
@@ -37,7 +40,6 @@ from suds_exp.campaign.bank import SampleBank, rounded_conditions
 from suds_exp.campaign.definition import (
     CampaignOptions,
     Plan,
-    differences,
     make_plan,
     merge_stored,
     normalise,
@@ -50,12 +52,15 @@ from suds_exp.campaign.sampling import check_feasible
 from suds_exp.errors import CampaignError, StoreError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
+from suds_exp.store.definition import check_same
 
 BACKENDS = ("loky", "dask")
 #: A batch is written when it holds this many rows ...
 BATCH_ROWS = 500
 #: ... or when this many seconds passed since the last write, whichever comes first.
 FLUSH_SECONDS = 5.0
+#: How long to wait for a dask scheduler to answer before refusing the run, in s.
+SCHEDULER_WAIT_S = 5.0
 
 
 @dataclass
@@ -227,6 +232,8 @@ def run_campaign(
     RunSummary
     """
     check_backend(backend, scheduler, jobs)
+    if scheduler:
+        check_scheduler(scheduler)
     options = options or CampaignOptions()
     started = time.perf_counter()
     with RunLock(store.path, name):
@@ -269,6 +276,29 @@ def check_backend(backend: str, scheduler: str | None, jobs: int) -> None:
         )
 
 
+def check_scheduler(address: str, wait_s: float = SCHEDULER_WAIT_S) -> None:
+    """Raise `CampaignError` when nothing answers at the dask scheduler ``address``
+    (``tcp://host:port``) within ``wait_s`` s, before a campaign is created or continued."""
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    host, colon, port = rest.rpartition(":")
+    if scheme not in ("tcp", "tls") or not colon or not port.isdigit():
+        raise CampaignError(
+            f"scheduler {address!r}: expected tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786",
+            param="scheduler",
+        )
+    try:
+        socket.create_connection((host.strip("[]") or "127.0.0.1", int(port)), wait_s).close()
+    except OSError as exc:
+        reason = (exc.strerror or str(exc) or type(exc).__name__).lower()
+        raise CampaignError(
+            f"scheduler {address}: no dask scheduler answers there ({reason}); start one "
+            "with `dask scheduler` or leave scheduler out for a local cluster",
+            param="scheduler",
+        ) from None
+
+
 def plan_campaign(
     store: Store, name: str, options: CampaignOptions, stored: dict | None, samples=None
 ) -> tuple[Plan, SampleBank]:
@@ -286,14 +316,13 @@ def plan_campaign(
         name, options, rounded_conditions(samples), lambda c: SampleBank.build(samples, c)
     )
     if stored is not None:
-        diff = differences(stored, normalise(plan.definition))
-        if diff:
-            raise CampaignError(
-                f"campaign {name!r} exists with a different definition ("
-                + "; ".join(diff[:6])
-                + (f"; and {len(diff) - 6} more" if len(diff) > 6 else "")
-                + "); continue it with its stored options or choose a new NAME"
-            )
+        check_same(
+            stored,
+            normalise(plan.definition),
+            f"campaign {name!r}",
+            "continue it with its stored options or choose a new NAME",
+            CampaignError,
+        )
     # With skip_infeasible the plan already left out every cell the data cannot
     # supply; conditions without any complete cycle are refused either way.
     needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
@@ -384,38 +413,95 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
     from joblib import Parallel, delayed, parallel_config
 
     if backend == "loky":
-        from joblib.externals.loky.backend import resource_tracker
-
-        folder = stack.enter_context(tempfile.TemporaryDirectory(prefix="suds_bank_"))
-        # loky's resource tracker removes the folder if this process dies (kill -9).
-        resource_tracker.register(folder, "folder")
-        stack.callback(resource_tracker.unregister, folder, "folder")
-        shared = bank.memmapped(folder)
+        shared = bank.memmapped(_bank_folder(stack))
         stack.enter_context(parallel_config(backend="loky", n_jobs=jobs))
     else:
         from dask.distributed import Client, LocalCluster
 
         if scheduler:
-            stack.enter_context(Client(scheduler))
+            stack.enter_context(Client(scheduler, timeout=SCHEDULER_WAIT_S))
         else:
-            cluster = stack.enter_context(
-                LocalCluster(
+            with _sigint_blocked():
+                cluster = LocalCluster(
                     n_workers=_n_workers(jobs),
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
+                    # workers ignore Ctrl-C: this process stops the run (dask_worker.py)
+                    preload=["suds_exp.campaign.dask_worker"],
+                    # closing busy workers is not worth a warning on the terminal
+                    silence_logs=logging.ERROR,
                 )
-            )
+            stack.enter_context(cluster)
             stack.enter_context(Client(cluster))
         # Scattered once to every worker; joblib swaps the argument for its future.
         shared = bank
         stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
-    gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
-        delayed(run_chunk)(shared, c, *args, blas="pin" if backend == "loky" else "block")
-        for c in chunks
-    )
+    # loky workers end with this process, even after kill -9 (see `job.watch_parent`)
+    worker_args = {"blas": "pin", "parent": os.getpid()} if backend == "loky" else {"blas": "block"}
+    # loky starts its workers here, with SIGINT ignored like dask's (`_sigint_blocked`);
+    # dask's are up already, and this call may take a while (scatter)
+    with _sigint_blocked() if backend == "loky" else contextlib.nullcontext():
+        gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
+            delayed(run_chunk)(shared, c, *args, **worker_args) for c in chunks
+        )
     stack.callback(getattr(gen, "close", lambda: None))
     return gen
+
+
+BANK_PREFIX = "suds_bank_"
+
+
+def _bank_folder(stack: contextlib.ExitStack) -> Path:
+    """A new temporary folder for the memory-mapped bank, removed when ``stack`` closes.
+
+    It holds a file lock for as long as this process lives; a folder whose lock is free
+    belonged to a process that was killed before it could remove it (kill -9), and is
+    removed by the next run."""
+    from filelock import FileLock, Timeout
+
+    for old in Path(tempfile.gettempdir()).glob(BANK_PREFIX + "*"):
+        lock = FileLock(old / "owner.lock")
+        try:
+            if time.time() - old.stat().st_mtime < 60:
+                continue  # just made: its owner may not hold the lock yet
+            lock.acquire(timeout=0)
+        except (Timeout, OSError):
+            continue
+        lock.release()
+        shutil.rmtree(old, ignore_errors=True)
+    folder = Path(tempfile.mkdtemp(prefix=BANK_PREFIX))
+    stack.callback(shutil.rmtree, folder, ignore_errors=True)
+    lock = FileLock(folder / "owner.lock")
+    lock.acquire(timeout=0)
+    stack.callback(lock.release)
+    return folder
+
+
+@contextlib.contextmanager
+def _sigint_blocked() -> Iterator[None]:
+    """Worker processes started inside the block ignore SIGINT for their whole life.
+
+    A terminal's Ctrl-C reaches the whole process group; only this process should act on
+    it (it stops the run and its workers). A worker hit while it starts prints a
+    traceback (and a dask cluster then fails to start), so workers are started while
+    SIGINT is ignored, which a new process inherits (a blocked mask it does not: Python's
+    process spawning resets it). This thread blocks SIGINT meanwhile, so a Ctrl-C that
+    lands on it is served when the block ends; one that the kernel hands to another
+    thread in that moment (a BLAS thread) is lost, and the user presses Ctrl-C again.
+    """
+    if not hasattr(signal, "pthread_sigmask") or (
+        threading.current_thread() is not threading.main_thread()
+    ):
+        yield
+        return
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler if old is None else old)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 @dataclass(frozen=True)
@@ -470,9 +556,12 @@ def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
         last = time.monotonic()
         try:
             with contextlib.ExitStack() as stack:
-                rows_iter = _results_iter(
-                    bank, chunks, plan, how.jobs, how.backend, how.scheduler, stack
-                )
+                # a cluster stopped while it starts fails on its own assertions: a
+                # Ctrl-C then is served once it is up
+                with signals.shielded():
+                    rows_iter = _results_iter(
+                        bank, chunks, plan, how.jobs, how.backend, how.scheduler, stack
+                    )
                 for rows in rows_iter:
                     buffer.extend(rows)
                     advance(len(rows))

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import sqlalchemy as sa
 
 from suds_exp.discrepancy.discover import Constancy, Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
@@ -44,6 +45,7 @@ from suds_exp.preprocess.version import get_version
 from suds_exp.progress import progress_lines
 from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 from suds_exp.sim.config import SimConfig
+from suds_exp.store.files import check_writable
 
 
 @dataclass
@@ -732,14 +734,52 @@ def run_discrepancy(
     -------
     DiscrepancyResult
     """
-    started, cpu_started = time.perf_counter(), time.process_time()
     started_at = _dt.datetime.now()
     opts = options or DiscrepancyOptions()
     check_options(opts)
+    name = name or default_name(started_at)
+    if out is not None:
+        check_writable(out, "out: report folder", DiscrepancyError, param="out")
+    if store is None:
+        return _run(None, prep, model, name, trials, opts, out, samples, progress, started_at)
+    # One writer at a time, from the name check to the stored run: two runs never take
+    # the same name or report folder (and migration 016 makes the name unique).
+    with store.locked("discrepancy", name):
+        if store.path.exists():
+            store.upgrade()  # a schema this code cannot write is refused before the work
+        check_free(store, name, out)
+        return _run(store, prep, model, name, trials, opts, out, samples, progress, started_at)
+
+
+def check_free(store, name: str, out: str | Path | None) -> None:
+    """Raise `DiscrepancyError` when ``name`` or the report folder ``out`` belongs to a
+    stored run already."""
+    if not store.path.exists():
+        return
+    with store.read() as conn:
+        if not sa.inspect(conn).has_table("discrepancy_runs"):
+            return
+        rows = conn.execute(sa.text("SELECT id, name, report_dir FROM discrepancy_runs")).fetchall()
+    for run_id, other, folder in rows:
+        if other == name:
+            raise DiscrepancyError(
+                f"name {name!r}: discrepancy run {run_id} already has that name; choose "
+                "another name",
+                param="name",
+            )
+        if out is not None and folder and Path(folder).resolve() == Path(out).resolve():
+            raise DiscrepancyError(
+                f"out {out}: the report folder of discrepancy run {run_id} ({other!r}); "
+                "choose another folder",
+                param="out",
+            )
+
+
+def _run(store, prep, model, name, trials, opts, out, samples, progress, started_at):
+    started, cpu_started = time.perf_counter(), time.process_time()
     say = progress_lines(progress)
     loaded = load(store, prep, trials, samples, opts.passive)
     model = model or SimConfig()
-    name = name or default_name(started_at)
     rng = np.random.default_rng(opts.seed)
     w = cut_windows(loaded, opts.replay or settings_from_prep(loaded.prep_params), rng)
     say(

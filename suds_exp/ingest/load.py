@@ -184,7 +184,7 @@ def ingest_paths(
     source = str(layout) if layout else "layout"
     enabled = progress and len(files) > 1
     bar = progress_bar("Ingesting", total=len(files), enabled=enabled, unit="files")
-    with bar as advance, store.writer() as conn:
+    with store.locked("ingest"), bar as advance, store.writer() as conn:
         for path in files:
             condition = conditions.get(Path(path).resolve())
             try:

@@ -326,6 +326,13 @@ def preprocess(
     started = time.perf_counter()
     model = SwimmerModel() if body is None else body
     params = model.version_params(resolve_params(params, preset))
+    # One writer at a time from reading what is done to the last sample stored: two
+    # runs of the same version never both find a trial to do (store/lock.py).
+    with store.locked("preprocess", name):
+        return _preprocess(store, name, params, trials, progress, started, model)
+
+
+def _preprocess(store, name, params, trials, progress, started, model) -> PrepResult:
     digest = params_hash(params)
     with store.write() as conn:
         row = find_version(conn, name, digest)

@@ -9,6 +9,7 @@ process that finds the file locked retries for a few seconds before giving up.
 from __future__ import annotations
 
 import os
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -19,6 +20,7 @@ import sqlalchemy as sa
 from sqlalchemy.pool import NullPool
 
 from suds_exp.errors import StoreError
+from suds_exp.store.integrity import check_file
 
 DEFAULT_DB = "suds.duckdb"
 #: On-disk format of new files: the newest one the released DuckDB CLI (`duckdb-cli`
@@ -52,6 +54,16 @@ def is_lock_error(exc: BaseException) -> bool:
     return "Could not set lock" in text or "Conflicting lock" in text
 
 
+_HOLDER = re.compile(r"Conflicting lock is held in (.+?) \(PID (\d+)\)")
+
+
+def lock_holder(exc: BaseException) -> str:
+    """The program and pid DuckDB names as holding its file in ``exc``'s text
+    ("/usr/bin/python3.12, pid 4242"), or "owner unknown"."""
+    m = _HOLDER.search(str(exc))
+    return f"{m.group(1)}, pid {m.group(2)}" if m else "owner unknown"
+
+
 #: DuckDB's words for a file it cannot use -> what to tell the user (after the path).
 _OPEN_PROBLEMS = (
     ("not a valid DuckDB database file", "not a DuckDB database file"),
@@ -63,6 +75,11 @@ _OPEN_PROBLEMS = (
     ("Permission denied", "permission denied: cannot create or write the database there"),
     ("No such file or directory", "cannot create the database: no such folder"),
     ("Read-only file system", "cannot create or write the database on a read-only file system"),
+    ("No space left", "no space left on the device; nothing was written"),
+    (
+        "Corrupt database file",
+        "the database file is damaged (a block fails its checksum); restore it from a copy",
+    ),
 )
 
 
@@ -83,41 +100,12 @@ def open_problem(exc: BaseException, path: Path) -> StoreError | None:
     return StoreError(f"{path}: cannot open the database: {text.splitlines()[0]}")
 
 
-#: DuckDB writes its files in whole 4 KiB sectors (3 header sectors, then blocks of
-#: whole sectors), so any other size is a copy cut short.
-SECTOR_BYTES = 4096
-
-
-def check_whole(path: Path) -> None:
-    """Raise the one-line `StoreError` for an existing file that is not a DuckDB database
-    (no ``DUCK`` magic after the header checksum) or whose size is not a whole number of
-    DuckDB sectors: DuckDB itself opens a file cut short and fails only when a query
-    reaches a missing block, possibly after a write began."""
-    try:
-        if not path.is_file():
-            return
-        size = path.stat().st_size
-        with path.open("rb") as f:
-            head = f.read(12)
-    except OSError:
-        return
-    if size == 0:
-        return
-    if head[8:12] != b"DUCK":
-        raise StoreError(f"{path}: not a DuckDB database file")
-    if size % SECTOR_BYTES:
-        raise StoreError(
-            f"{path}: the database file is truncated or damaged ({size} bytes is not a whole "
-            f"number of {SECTOR_BYTES}-byte sectors); restore it from a copy"
-        )
-
-
 def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAIT_S) -> T:
     """Call ``open_fn`` until it stops failing on a file lock, for at most ``wait_s`` s.
 
     A file DuckDB cannot open for another reason (not a database, truncated, a folder
     that cannot be written) raises a one-line `StoreError` naming it."""
-    check_whole(path)
+    check_file(path)
     deadline = time.monotonic() + wait_s
     delay = 0.02
     while True:
@@ -130,9 +118,8 @@ def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAI
                     raise
                 raise problem from None
             if time.monotonic() >= deadline:
-                holder = str(exc).split("Conflicting lock is held in", 1)[-1].split(".")[0]
                 raise StoreError(
-                    f"{path}: the database is held by another process ({holder.strip()}); "
+                    f"{path}: the database is held by another process ({lock_holder(exc)}); "
                     f"waited {wait_s:g} s. Try again when it finishes."
                 ) from None
             time.sleep(delay)

@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import itertools
+import signal
+import threading
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+import duckdb
 import pandas as pd
 import sqlalchemy as sa
 
 from suds_exp.errors import StoreError
 from suds_exp.store import migrate
 from suds_exp.store.engine import default_db_path, make_engine, open_problem, retry_on_lock
+from suds_exp.store.integrity import mark_written
+from suds_exp.store.lock import WriteLock
 
 _frame_names = itertools.count()
 
@@ -24,7 +29,9 @@ class Store:
     ``with store.write() as conn`` gives a SQLAlchemy connection inside one transaction
     (committed when the block ends, rolled back if it raises) after applying pending
     migrations; ``with store.read() as conn`` gives a read-only one. Both wait briefly
-    when another process holds the file.
+    when another process holds the file. ``with store.locked(command, name):`` holds the
+    database's write lock (`suds_exp.store.lock`) for a whole command; every write takes
+    it too. A damaged file is refused before it is opened (`suds_exp.store.integrity`).
 
     Parameters
     ----------
@@ -40,21 +47,33 @@ class Store:
         return f"Store({str(self.path)!r})"
 
     # -- connections ---------------------------------------------------------------
+    def locked(self, command: str, name: str | None = None, wait_s: float | None = None):
+        """The database's write lock for ``command`` (its ``name``: the campaign, stream,
+        version or run), a context manager; another writer waits up to ``wait_s`` s
+        (default `suds_exp.store.lock.WRITE_WAIT_S`) and is then refused in one line."""
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise open_problem(exc, self.path) from None
+        return WriteLock(self.path, command, name, wait_s)
+
     def upgrade(self, target: int | None = None) -> list[str]:
         """Create the file if needed and apply pending migrations; return their names.
 
         Refuses (`StoreError`) before the file or its folder is touched when no migration
         files are installed."""
         migrations = migrate.available_migrations()
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise open_problem(exc, self.path) from None
-        engine = make_engine(self.path)
-        try:
-            applied = retry_on_lock(lambda: migrate.apply(engine, migrations, target), self.path)
-        finally:
-            engine.dispose()
+        with self.locked("init"):
+            engine = make_engine(self.path)
+            try:
+                applied = retry_on_lock(
+                    lambda: migrate.apply(engine, migrations, target), self.path
+                )
+            except (duckdb.Error, sa.exc.DBAPIError) as exc:
+                raise _write_problem(exc, self.path) from None
+            finally:
+                engine.dispose()
+                mark_written(self.path)
         if target is None:
             self._migrated = True
         return applied
@@ -67,10 +86,16 @@ class Store:
         for the whole block, and DuckDB checkpoints once when it ends instead of after
         every transaction.
         """
-        if not self._migrated:
-            self.upgrade()
-        with self._connect(read_only=False) as conn:
-            yield conn
+        with self.locked("write"):
+            if not self._migrated:
+                self.upgrade()
+            try:
+                with self._connect(read_only=False) as conn:
+                    yield conn
+            except (duckdb.Error, sa.exc.DBAPIError) as exc:
+                raise _write_problem(exc, self.path) from None
+            finally:
+                mark_written(self.path)
 
     @contextmanager
     def write(self) -> Iterator[sa.Connection]:
@@ -95,10 +120,14 @@ class Store:
         engine = make_engine(self.path, read_only=read_only)
         try:
             conn = retry_on_lock(engine.connect, self.path)
-            with conn:
+            try:
                 yield conn
+            finally:
+                with _sigint_deferred():
+                    conn.close()
         finally:
-            engine.dispose()
+            with _sigint_deferred():
+                engine.dispose()
 
     # -- bulk data -------------------------------------------------------------------
     @staticmethod
@@ -138,3 +167,37 @@ class Store:
         """Run ``query`` on a read-only connection and return a DataFrame."""
         with self.read() as conn:
             return self.frame(conn, query, params)
+
+
+@contextmanager
+def _sigint_deferred() -> Iterator[None]:
+    """Serve a Ctrl-C that arrives inside the block after it: closing a connection half
+    way makes SQLAlchemy log a multi-line "Exception closing connection"."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    old = signal.signal(signal.SIGINT, lambda signum, frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler if old is None else old)
+    if caught:
+        # delivered again to whoever handled it before (a campaign defers it itself)
+        signal.raise_signal(signal.SIGINT)
+
+
+def _write_problem(exc: BaseException, path: Path) -> Exception:
+    """The one-line `StoreError` for a write DuckDB refused: a unique key another process
+    already filled (the last defence against two writers), a file-system error, a
+    damaged block; any other error is returned as it is, to surface unchanged."""
+    orig = getattr(exc, "orig", exc)
+    if isinstance(orig, duckdb.ConstraintException):
+        first = str(orig).strip().splitlines()[0]
+        return StoreError(
+            f"{path}: refused a duplicate: {first}; another process stored these rows "
+            "first; nothing of this transaction was written"
+        )
+    if isinstance(orig, duckdb.IOException):
+        return open_problem(orig, path) or exc
+    return exc

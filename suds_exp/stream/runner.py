@@ -20,11 +20,11 @@ from datetime import UTC, datetime
 import pandas as pd
 import sqlalchemy as sa
 
-from suds_exp.campaign.definition import differences, resolve_models
-from suds_exp.campaign.lock import RunLock
+from suds_exp.campaign.definition import resolve_models
 from suds_exp.errors import StreamError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
+from suds_exp.store.definition import check_same
 from suds_exp.stream.prequential import StreamSettings, run_trial, trial_cycles
 
 _SCHEDULE = re.compile(r"schedule=\S+@([0-9.eE+-]+)s")
@@ -77,7 +77,7 @@ def run_stream(
     trials: list[int] | None = None,
     prep: str | None = None,
     settings: StreamSettings | None = None,
-    change_at: float | None = None,
+    change_at: float | str | None = None,
     samples: pd.DataFrame | None = None,
     progress: bool = True,
     on_unit: Callable[[int], None] | None = None,
@@ -96,34 +96,88 @@ def run_stream(
         raise StreamError(
             f"warmup_cycles: {settings.warmup_cycles}; expected >= 1 cycle", param="warmup_cycles"
         )
-    prep, samples, trials = _stream_samples(store, prep, trials, samples)
-    changes = _stream_changes(store, samples, trials, change_at, settings)
-    definition = _definition(models, trials, prep, settings, changes)
-    summary = StreamSummary(name, len(definition["models"]) * len(trials), 0, trials=trials)
-    with RunLock(store.path, name):
-        summary.created = _register(store, name, prep, definition)
-        done = _done_units(store, name)
+    change_at = parse_change_at(change_at)
+    resolve_models(models, "measured")  # a bad learner or parameter: before anything else
+    with store.locked("stream", name):
+        prep, samples, trials = _stream_samples(store, prep, trials, samples)
+        changes = _stream_changes(store, samples, trials, change_at, settings)
+        definition = _definition(models, trials, prep, settings, changes)
+        summary = StreamSummary(name, len(definition["models"]) * len(trials), 0, trials=trials)
+        stored = _stored_definition(store, name)
+        if stored is not None:
+            check_same(
+                stored,
+                definition,
+                f"stream {name!r}",
+                "use the same options or a new name",
+                StreamError,
+            )
+        done = _done_units(store, name) if stored is not None else set()
         summary.done_before = len(done)
         by_trial = {int(t): g for t, g in samples.groupby("trial_id", sort=True)}
+        todo = [
+            (tid, model, params)
+            for tid in trials
+            for model, params in definition["models"].items()
+            if (model, tid) not in done
+        ]
+        # Every learner's first unit is computed before anything is stored, so a learner
+        # that cannot run with these settings (too short a warm-up...) is refused with
+        # the database unchanged and the name still free.
+        first: dict[tuple[str, int], pd.DataFrame] = {}
+        for tid, model, params in todo:
+            if not any(m == model for m, _ in first):
+                rows = _unit_rows(by_trial[tid], name, model, params, settings, changes)
+                first[(model, tid)] = rows
         bar = progress_bar(
             f"Stream {name}", summary.units, progress, done=summary.done_before, unit="runs"
         )
         with bar as advance:
-            for tid in trials:
-                for model, params in definition["models"].items():
-                    if (model, tid) in done:
-                        continue
-                    rows = run_trial(by_trial[tid], model, params, settings)
-                    rows.insert(0, "stream", name)
-                    rows["change_s"] = changes[tid]
-                    with store.write() as conn:
-                        Store.insert_df(conn, "stream_cycles", rows)
-                    summary.done_now += 1
-                    summary.rows_now += len(rows)
-                    advance()
-                    if on_unit is not None:
-                        on_unit(summary.done_before + summary.done_now)
+            for tid, model, params in todo:
+                if (model, tid) in first:
+                    rows = first.pop((model, tid))
+                else:
+                    rows = _unit_rows(by_trial[tid], name, model, params, settings, changes)
+                with store.write() as conn:
+                    if stored is None:
+                        _register(conn, name, prep, definition)
+                        stored, summary.created = definition, True
+                    Store.insert_df(conn, "stream_cycles", rows)
+                summary.done_now += 1
+                summary.rows_now += len(rows)
+                advance()
+                if on_unit is not None:
+                    on_unit(summary.done_before + summary.done_now)
+        if stored is None:  # nothing to run (no scored cycle): still record the stream
+            with store.write() as conn:
+                _register(conn, name, prep, definition)
+            summary.created = True
     return summary
+
+
+def parse_change_at(value: float | str | None) -> float | None:
+    """``change_at`` as a time in s (> 0), from a number or its text; None stays None."""
+    if value is None:
+        return None
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise StreamError(
+            f"change_at {value!r}: expected a time in s, e.g. 20", param="change_at"
+        ) from None
+    if not out > 0:
+        raise StreamError(
+            f"change_at {value!r}: expected a time > 0 s after the trial's start",
+            param="change_at",
+        )
+    return out
+
+
+def _unit_rows(trial, name, model, params, settings, changes) -> pd.DataFrame:
+    rows = run_trial(trial, model, params, settings)
+    rows.insert(0, "stream", name)
+    rows["change_s"] = changes[int(trial["trial_id"].iloc[0])]
+    return rows
 
 
 def _stream_samples(store: Store, prep, trials, samples):
@@ -186,30 +240,32 @@ def _has_trials(store: Store) -> bool:
         return sa.inspect(conn).has_table("trials")
 
 
-def _register(store: Store, name: str, prep: str, definition: dict) -> bool:
-    """Store a new stream's definition, or check a continuation against it."""
-    text = json.dumps(definition, sort_keys=True)
-    with store.write() as conn:
+def _stored_definition(store: Store, name: str) -> dict | None:
+    if not store.path.exists():
+        return None
+    with store.read() as conn:
+        if not sa.inspect(conn).has_table("streams"):
+            return None
         row = conn.execute(
             sa.text("SELECT definition FROM streams WHERE name = :n"), {"n": name}
         ).first()
-        if row is None:
-            conn.execute(
-                sa.text(
-                    "INSERT INTO streams (name, prep_version, definition, created_at) "
-                    "VALUES (:n, :p, :d, :c)"
-                ),
-                {"n": name, "p": prep, "d": text, "c": datetime.now(UTC).replace(tzinfo=None)},
-            )
-            return True
-    stored = json.loads(row.definition)
-    diff = differences(stored, json.loads(text))
-    if diff:
-        raise StreamError(
-            f"stream {name!r} exists with a different definition ({'; '.join(diff)}); "
-            "use the same options or a new name"
-        )
-    return False
+    return None if row is None else json.loads(row.definition)
+
+
+def _register(conn: sa.Connection, name: str, prep: str, definition: dict) -> None:
+    """Store a new stream's definition (in the transaction of its first rows)."""
+    conn.execute(
+        sa.text(
+            "INSERT INTO streams (name, prep_version, definition, created_at) "
+            "VALUES (:n, :p, :d, :c)"
+        ),
+        {
+            "n": name,
+            "p": prep,
+            "d": json.dumps(definition, sort_keys=True),
+            "c": datetime.now(UTC).replace(tzinfo=None),
+        },
+    )
 
 
 def _done_units(store: Store, name: str) -> set[tuple[str, int]]:

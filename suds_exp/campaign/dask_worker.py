@@ -1,0 +1,21 @@
+"""Preloaded into every dask worker a campaign's local cluster starts (`preload=`).
+
+A terminal's Ctrl-C reaches the whole process group, workers included; the campaign's
+own process stops the run and closes the cluster, so a worker ignores SIGINT instead of
+printing its own KeyboardInterrupt traceback.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+
+
+def dask_setup(worker) -> None:
+    """Called by dask in each worker process as it starts."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+# importing happens before dask_setup, as early as a worker can act
+dask_setup(None)
