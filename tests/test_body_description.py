@@ -75,6 +75,16 @@ BAD = {
     "both kinds": (CHAIN + SEGMENTS.split("\n", 2)[2], "expected either [segments.*] or [chain]"),
     "too many modes": (CHAIN.replace("modes = 3", "modes = 4"), "chain.modes: 4"),
     "not toml": ("name = ", "not valid TOML"),
+    "frame marker of another segment": (
+        SEGMENTS.replace('b2 = "top" }', 'b2 = "top" }\nframe = ["b1", "f1"]'),
+        "segments.back.frame: expected a list of the segment's own markers (b1, b2)",
+    ),
+    "a segment with two parent joints": (
+        SEGMENTS.replace('markers = { b1 = "top", b2 = "top" }', 'markers = { b1 = "t", b2 = "t" }')
+        + '[segments.side]\nmarkers = { s1 = "t", s2 = "t" }\n'
+        + '[[joints]]\nname = "other"\nparent = "side"\nchild = "back"\nkind = "passive"\n',
+        "joints[1] 'other': 'back' is already the child of joint 'hinge'",
+    ),
 }
 
 
