@@ -83,13 +83,11 @@ suds-exp init --db q.duckdb
 suds-exp sql "SELECT table_name, table_type FROM information_schema.tables WHERE table_schema = 'main'" \
   --db q.duckdb --json >catalog.json
 python - "$REPO" <<'EOF'
-import json, re, sys
+import json, sys
 from pathlib import Path
-tables, views = {"schema_migrations"}, set()
-pattern = re.compile(r"CREATE\s+(?:OR\s+REPLACE\s+)?(TABLE|VIEW)\s+(?:IF\s+NOT\s+EXISTS\s+)?(\w+)", re.I)
-for path in Path(sys.argv[1], "migrations").glob("*.sql"):
-    for kind, name in pattern.findall(path.read_text()):
-        (tables if kind.upper() == "TABLE" else views).add(name)
+sys.path.insert(0, sys.argv[1])
+from tests.migration_text import created_by_migrations
+tables, views = created_by_migrations(Path(sys.argv[1], "migrations"))
 rows = json.load(open("catalog.json"))
 got_t = {r["table_name"] for r in rows if r["table_type"] == "BASE TABLE"}
 got_v = {r["table_name"] for r in rows if r["table_type"] == "VIEW"}

@@ -21,6 +21,7 @@ from typer.testing import CliRunner
 import suds_exp
 from cli import app
 from suds_exp.store import migrate
+from tests.migration_text import created_by_migrations
 
 REPO = Path(__file__).resolve().parents[1]
 runner = CliRunner()
@@ -59,19 +60,6 @@ def test_python_m_suds_exp_runs_the_same_app():
     assert len(commands) > 10
     for name in commands:
         assert f"│ {name} " in result.stdout, name
-
-
-def created_by_migrations(folder: Path) -> tuple[set[str], set[str]]:
-    """Table and view names the SQL files in ``folder`` create (read from their text, so
-    independently of the runner)."""
-    tables, views = {"schema_migrations"}, set()
-    pattern = re.compile(
-        r"CREATE\s+(?:OR\s+REPLACE\s+)?(TABLE|VIEW)\s+(?:IF\s+NOT\s+EXISTS\s+)?(\w+)", re.I
-    )
-    for path in folder.glob("*.sql"):
-        for kind, name in pattern.findall(path.read_text(encoding="utf-8")):
-            (tables if kind.upper() == "TABLE" else views).add(name)
-    return tables, views
 
 
 def catalog(db: Path) -> tuple[set[str], set[str], list[int]]:

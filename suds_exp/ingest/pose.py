@@ -90,8 +90,14 @@ def pose_software(path: Path, data: bytes) -> str | None:
     if suffix == ".h5":
         if not data.startswith(b"\x89HDF"):
             return None
-        import h5py
-
+        try:
+            import h5py
+        except ImportError:
+            raise IngestError(
+                f"{path}: reading HDF5 keypoint files needs the optional packages of "
+                "suds-exp's 'pose' extra (pip install 'suds-exp[pose]')",
+                param="paths",
+            ) from None
         with h5py.File(path, "r") as f:
             if "tracks" in f and "node_names" in f:
                 return "sleap"
