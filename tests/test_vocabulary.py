@@ -111,6 +111,25 @@ def test_only_preprocess_reads_its_tables():
     assert readers == []
 
 
+def test_unnamed_runs_started_in_the_same_second_get_names_of_their_own(
+    two_versions, tmp_path, monkeypatch
+):
+    """The default name has a resolution of one second and names are unique (migration
+    016): a second unnamed run in that second takes the next free name, not a refusal."""
+    from suds_exp.discrepancy import workflow
+
+    db = tmp_path / "db.duckdb"
+    shutil.copyfile(two_versions, db)
+    monkeypatch.setattr(workflow, "default_name", lambda when=None: "discrepancy-same-second")
+    opts = DiscrepancyOptions(max_effects=0, refine=False)
+    names = [run_discrepancy(Store(db), prep="v1", options=opts).name for _ in range(3)]
+    assert names == [
+        "discrepancy-same-second",
+        "discrepancy-same-second-2",
+        "discrepancy-same-second-3",
+    ]
+
+
 def test_replay_uses_the_versions_own_differentiator(two_versions, tmp_path):
     db = tmp_path / "db.duckdb"
     shutil.copyfile(two_versions, db)

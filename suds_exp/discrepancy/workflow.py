@@ -737,6 +737,7 @@ def run_discrepancy(
     started_at = _dt.datetime.now()
     opts = options or DiscrepancyOptions()
     check_options(opts)
+    named = name is not None
     name = name or default_name(started_at)
     if out is not None:
         check_writable(out, "out: report folder", DiscrepancyError, param="out")
@@ -747,8 +748,28 @@ def run_discrepancy(
     with store.locked("discrepancy", name):
         if store.path.exists():
             store.upgrade()  # a schema this code cannot write is refused before the work
+        if not named:
+            name = free_name(store, name)
         check_free(store, name, out)
         return _run(store, prep, model, name, trials, opts, out, samples, progress, started_at)
+
+
+def stored_names(store) -> set[str]:
+    """The names of the discrepancy runs stored in ``store`` (empty for a new file)."""
+    if not store.path.exists():
+        return set()
+    with store.read() as conn:
+        if not sa.inspect(conn).has_table("discrepancy_runs"):
+            return set()
+        return set(conn.execute(sa.text("SELECT name FROM discrepancy_runs")).scalars())
+
+
+def free_name(store, base: str) -> str:
+    """``base``, or ``base-2``, ``base-3``, ... when a stored run has it: two unnamed runs
+    started within the same second get names of their own."""
+    taken = stored_names(store)
+    candidates = (base, *(f"{base}-{k}" for k in range(2, len(taken) + 3)))
+    return next(n for n in candidates if n not in taken)
 
 
 def check_free(store, name: str, out: str | Path | None) -> None:
