@@ -37,9 +37,10 @@ from threadpoolctl import threadpool_limits
 from suds_exp.analysis.categories import main_cycles
 from suds_exp.analysis.glm import glm_formulas, identifiable_columns
 from suds_exp.errors import AnalysisError
+from suds_exp.models.registry import LEARNERS
 
-#: Learner names as stored in ``results.model``.
-PHASE, TLS, TLSS, GMR, GMRS = "phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS"
+#: The learners' roles in the findings (names as stored in ``results.model``).
+PHASE, TLS, TLSS, GMR, GMRS = LEARNERS
 #: A training size of at most this many cycles is "a few cycles" (F8).
 FEW_CYCLES = 3
 #: Verdicts, in the order a summary lists them.

@@ -33,8 +33,9 @@ import pandas as pd
 from suds_exp.analysis.categories import learner_order
 from suds_exp.campaign.grid import KEY_COLUMNS
 from suds_exp.errors import AnalysisError
+from suds_exp.models.registry import GMR
 
-REFERENCE = "GMR"
+REFERENCE = GMR
 OWN_FACTOR = 1.25
 
 
