@@ -222,12 +222,8 @@ def learner_glm(
     much larger (in 100 ln units) its error is than GMR's in the reference category; an
     interaction is how much more (or less) than GMR it loses in that category.
     """
-    import statsmodels.api as sm
-    import statsmodels.formula.api as smf
-    from threadpoolctl import threadpool_limits
-
     from suds_exp.analysis.glm import REFERENCE as SIMILARITY_REFERENCE
-    from suds_exp.analysis.glm import identifiable_columns
+    from suds_exp.analysis.glm import fit_formula
 
     rows = results[results["n_cycles"] == main_cycles]
     frame = pd.DataFrame(
@@ -256,35 +252,13 @@ def learner_glm(
         "direct": "y ~ " + " + ".join(terms + similarity),
         "interactions": f"y ~ {terms[0]} * ({' + '.join(similarity)})",
     }
+    # terms the data cannot tell apart (e.g. same gait = same period when every condition
+    # has one frequency) are NaN, as R's lm reports NA (glm.py does too)
     tables = []
-    with threadpool_limits(limits=1, user_api="blas"):
-        for label, formula in formulas.items():
-            design = smf.ols(formula, frame)
-            names = design.exog_names
-            # terms the data cannot tell apart (e.g. same gait = same period when every
-            # condition has one frequency) are NaN, as R's lm reports NA (glm.py does too)
-            keep = identifiable_columns(design.exog)
-            fit = sm.OLS(design.endog, design.exog[:, keep]).fit()
-            coef, low, high, pval = (np.full(len(names), np.nan) for _ in range(4))
-            ci = np.asarray(fit.conf_int(alpha=alpha))
-            coef[keep], low[keep], high[keep], pval[keep] = (
-                fit.params,
-                ci[:, 0],
-                ci[:, 1],
-                fit.pvalues,
-            )
-            tables.append(
-                pd.DataFrame(
-                    {
-                        "model": label,
-                        "term": [_short_term(t) for t in names],
-                        "coef": coef,
-                        "ci_low": low,
-                        "ci_high": high,
-                        "p_value": pval,
-                    }
-                )
-            )
+    for label, formula in formulas.items():
+        fit = fit_formula(formula, frame, alpha)
+        term = fit.pop("column").map(_short_term)
+        tables.append(pd.concat([pd.DataFrame({"model": label, "term": term}), fit], axis=1))
     out = pd.concat(tables, ignore_index=True)
     out.attrs["n_rows"] = len(frame)
     out.attrs["formulas"] = formulas
