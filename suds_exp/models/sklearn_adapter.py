@@ -39,7 +39,6 @@ from sklearn.preprocessing import StandardScaler
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
-    VB_COLUMNS,
     Learner,
     ModelError,
     TimeSeries,
@@ -52,6 +51,7 @@ from suds_exp.models.base import (
     rollout_bounds,
 )
 from suds_exp.models.registry import SUDS_SUFFIX
+from suds_exp.robot import VB_COLUMNS
 
 PREFIX = "sklearn:"
 #: Keyword arguments of `make_model` that configure the adapter, not the estimator.
