@@ -33,7 +33,7 @@ import pandas as pd
 from suds_exp.analysis.categories import learner_order
 from suds_exp.campaign.grid import KEY_COLUMNS
 from suds_exp.errors import AnalysisError
-from suds_exp.models.registry import GMR
+from suds_exp.models.registry import GMR, MLP
 
 REFERENCE = GMR
 OWN_FACTOR = 1.25
@@ -130,7 +130,7 @@ def _pooled_cycles(rows, model, reference, main_cycles, metric) -> tuple[float, 
 
 def efficiency_ratio(
     results: pd.DataFrame,
-    model: str = "MLP",
+    model: str = MLP,
     reference: str = REFERENCE,
     main_cycles: int = 30,
     metric: str = "rmse_vx",
@@ -282,7 +282,7 @@ SURVEY_COLUMNS = KEY_COLUMNS + (
 
 
 def survey_tables(
-    store, campaign: str, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
+    store, campaign: str, main_cycles: int = 30, n_boot: int = 1000, model: str = MLP
 ) -> dict:
     """Everything `suds-exp survey` prints: ``timing`` (`timing_table`); with a sweep,
     ``cycles`` (`cycles_to_target`) and ``ratio`` (`efficiency_ratio` of ``model`` against
@@ -295,7 +295,7 @@ def survey_tables(
 
 
 def survey_from_results(
-    results: pd.DataFrame, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
+    results: pd.DataFrame, main_cycles: int = 30, n_boot: int = 1000, model: str = MLP
 ) -> dict:
     """`survey_tables` of results already loaded (e.g. several campaigns pooled).
 
