@@ -447,8 +447,9 @@ def preprocess(
     suds-exp preprocess --body snake.toml (a marker chain: shape modes of chord angles)
     suds-exp preprocess --preset paper --name paper (the paper's own processing)
     """
-    from suds_exp.preprocess import list_versions, parse_param_items, parse_trial_ids
+    from suds_exp.preprocess import list_versions, parse_param_items
     from suds_exp.preprocess import preprocess as run_preprocess
+    from suds_exp.robot import parse_ids
 
     store = open_store(db)
     if list_:
@@ -461,7 +462,7 @@ def preprocess(
         return
     common = dict(
         params=parse_param_items(param or []),
-        trials=parse_trial_ids(trials_),
+        trials=parse_ids(trials_),
         progress=not (quiet or json_),
         preset=preset,
     )
@@ -740,9 +741,10 @@ def discrepancy(
 
     Example: suds-exp discrepancy --model-effect flippers=absent --max-effects 2
     """
-    from suds_exp.discrepancy import DiscrepancyOptions, parse_trial_ids, run_discrepancy
+    from suds_exp.discrepancy import DiscrepancyOptions, run_discrepancy
     from suds_exp.discrepancy.discover import DiscoverySettings
     from suds_exp.discrepancy.workflow import default_name, parse_exclude
+    from suds_exp.robot import parse_ids
     from suds_exp.sim.commands import build_config
 
     start = build_config(model, model_effect or [], param="model_effects")
@@ -763,7 +765,7 @@ def discrepancy(
         prep,
         start,
         name=name,
-        trials=parse_trial_ids(trials),
+        trials=parse_ids(trials),
         options=options,
         out=out,
         progress=not (quiet or json_),
@@ -844,7 +846,7 @@ def stream(
     --effect medium_compaction=on@20s --ingest && suds-exp preprocess && suds-exp stream
     bed --models GMR,OnlineGMR --plot reports/bed.png
     """
-    from suds_exp.preprocess import parse_trial_ids
+    from suds_exp.robot import parse_ids
     from suds_exp.store.files import check_writable
     from suds_exp.stream import StreamSettings, plot_error, run_stream, stream_rows, summarise
 
@@ -855,7 +857,7 @@ def stream(
         store,
         name,
         models,
-        parse_trial_ids(trials_),
+        parse_ids(trials_),
         prep,
         StreamSettings(warmup_cycles=warmup),
         change_at,
@@ -912,12 +914,12 @@ def gait_predict(
     Example: suds-exp gait predict --gait-file ellipse.toml --freq 1/2 --learner GMR --json
     """
     from suds_exp.gait.commands import predict_command
-    from suds_exp.preprocess import parse_trial_ids
+    from suds_exp.robot import parse_ids
     from suds_exp.sim.commands import parse_freqs
 
     (frequency,) = parse_freqs(freq)[:1]
     doc = predict_command(
-        open_store(db), gait_file, frequency, prep, learner, parse_trial_ids(trials_), boot, bound
+        open_store(db), gait_file, frequency, prep, learner, parse_ids(trials_), boot, bound
     )
     if json_:
         console.print_json(doc)

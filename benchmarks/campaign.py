@@ -59,10 +59,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from suds_exp.campaign import CampaignOptions, SampleBank, enumerate_draws, run_campaign  # noqa: E402
 from suds_exp.campaign.bank import rounded_conditions  # noqa: E402
 from suds_exp.campaign.conditions import PAPER_SWEEP, select_conditions  # noqa: E402
-from suds_exp.campaign.definition import LEARNERS, resolve_models  # noqa: E402
+from suds_exp.campaign.definition import resolve_models  # noqa: E402
 from suds_exp.campaign.job import RESULT_COLUMNS  # noqa: E402
 from suds_exp.campaign.sampling import draw_sample  # noqa: E402
 from suds_exp.models import make_model  # noqa: E402
+from suds_exp.models.registry import LEARNERS  # noqa: E402
 from suds_exp.robot import FREQUENCIES_HZ as FREQS  # noqa: E402
 from suds_exp.robot import GAITS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402

@@ -45,10 +45,9 @@ from statistics import median
 import numpy as np
 import pandas as pd
 
-from suds_exp.campaign.definition import SURVEY_LEARNERS
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
-from suds_exp.robot import LEARNERS
+from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
 from suds_exp.testing.synthetic_swimmer import make_samples
 
 SAMPLES_PER_CYCLE = 100

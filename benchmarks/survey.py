@@ -54,7 +54,7 @@ from suds_exp.analysis.survey import (  # noqa: E402
     survey_from_results,
 )
 from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
-from suds_exp.campaign.definition import LEARNERS  # noqa: E402
+from suds_exp.models.registry import LEARNERS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 

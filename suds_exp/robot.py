@@ -1,5 +1,5 @@
-"""The robot and the experiment, named once: gaits, frequencies, marker roles, learners,
-samples columns, and the parsers of the few strings that name them.
+"""The robot and the experiment, named once: gaits, frequencies, marker roles, samples
+columns, and the parsers of the few strings that name them.
 
 Every other module takes these from here (DESIGN.md, "The robot and its variables" and
 "Names other code relies on"). This module imports nothing of the package but its errors,
@@ -26,9 +26,6 @@ GAITS = ("S+", "S-", "O", "D-", "D+")
 GAIT_K = {"S+": -4.0, "S-": -9.0, "O": np.inf, "D-": 9.0, "D+": 4.0}
 #: The paper's gait frequencies, Hz.
 FREQUENCIES_HZ = (1 / 3, 1 / 2, 1.0)
-
-#: The paper's learners, in its order (`suds_exp.models.make_model` builds each).
-LEARNERS = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
 
 #: The robot's 11 marker roles and the segment each sits on: top-face, raised (spoke)
 #: and lowered markers of the head and tail segments, and one marker on each flipper

@@ -180,3 +180,19 @@ def test_sample_efficiency_slopes_recover_planted_power_laws(tmp_path):
         # Twice the 95 % half-width is ~3.9 standard errors: P(miss) ~1e-4 per slope.
         assert abs(r.slope - slopes[r.model]) <= 2 * half, r
         assert half < 0.1, r
+
+
+def test_fit_formula_is_ols_with_aliased_columns_nan():
+    """The one GLM fit: OLS estimates, and NaN for a column equal to an earlier one."""
+    import pandas as pd
+
+    from suds_exp.analysis.glm import fit_formula
+
+    rng = np.random.default_rng(0)
+    x = rng.normal(size=50)
+    frame = pd.DataFrame({"y": 2.0 + 3.0 * x + rng.normal(0, 0.01, 50), "x": x, "x2": x})
+    fit = fit_formula("y ~ x + x2", frame)
+    assert fit["column"].tolist() == ["Intercept", "x", "x2"]
+    assert fit["coef"].iloc[:2].to_numpy() == pytest.approx([2.0, 3.0], abs=0.01)
+    assert np.isnan(fit["coef"].iloc[2]) and fit.attrs["keep"] == [0, 1]
+    assert (fit["ci_low"].iloc[:2] < fit["coef"].iloc[:2]).all()

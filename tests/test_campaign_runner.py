@@ -13,7 +13,6 @@ from typer.testing import CliRunner
 import cli
 from suds_exp.campaign import (
     KEY_COLUMNS,
-    LEARNERS,
     TIMING_COLUMNS,
     CampaignError,
     CampaignOptions,
@@ -22,6 +21,7 @@ from suds_exp.campaign import (
 )
 from suds_exp.campaign.lock import RunLock
 from suds_exp.errors import StoreError
+from suds_exp.models.registry import LEARNERS
 from suds_exp.store import Store
 from suds_exp.testing.demo_campaign import demo_campaign, demo_options
 from tests.test_campaign_grid import synthetic_samples

@@ -12,12 +12,11 @@ from typer.testing import CliRunner
 
 from cli import app
 from suds_exp import robot
-from suds_exp.discrepancy import DiscrepancyOptions, parse_trial_ids, run_discrepancy
+from suds_exp.discrepancy import DiscrepancyOptions, run_discrepancy
 from suds_exp.discrepancy.replay import make_windows
 from suds_exp.errors import ConfigError
 from suds_exp.ingest import ingest_paths
 from suds_exp.preprocess import DEFAULTS, PreprocessError, get_version, preprocess
-from suds_exp.preprocess import parse_trial_ids as prep_trial_ids
 from suds_exp.store import Store
 from suds_exp.testing.synthetic_captures import write_dataset
 
@@ -43,12 +42,12 @@ def test_gaits_follow_the_design_formula():
 
 
 def test_one_id_parser_for_preprocess_and_discrepancy():
-    assert parse_trial_ids("1-3,8") == prep_trial_ids("1-3,8") == [1, 2, 3, 8]
-    assert parse_trial_ids(None) is None and parse_trial_ids(" ") is None
+    assert robot.parse_ids("1-3,8") == [1, 2, 3, 8]
+    assert robot.parse_ids(None) is None and robot.parse_ids(" ") is None
     for bad in ("a,b", "3-1", "0"):
         # the library names its parameter; the CLI names the flag (next test)
         with pytest.raises(ConfigError, match=f"^trials '{bad}'") as caught:
-            parse_trial_ids(bad)
+            robot.parse_ids(bad)
         assert caught.value.param == "trials"
 
 

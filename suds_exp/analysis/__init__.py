@@ -9,7 +9,7 @@ every table of the report is also a function returning a DataFrame::
     glm = glm_table(results)
 """
 
-from suds_exp.analysis.categories import GAIT_AXIS, LEARNERS, category_table, main_cycles
+from suds_exp.analysis.categories import GAIT_AXIS, category_table, main_cycles
 from suds_exp.analysis.findings import FINDINGS, findings, findings_summary, findings_table
 from suds_exp.analysis.glm import glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
@@ -21,7 +21,6 @@ from suds_exp.errors import AnalysisError
 __all__ = [
     "FINDINGS",
     "GAIT_AXIS",
-    "LEARNERS",
     "AnalysisError",
     "agreement_summary",
     "campaigns",

@@ -10,7 +10,8 @@ from __future__ import annotations
 import pandas as pd
 
 from suds_exp.errors import AnalysisError
-from suds_exp.robot import GAITS, LEARNERS
+from suds_exp.models.registry import LEARNERS
+from suds_exp.robot import GAITS
 
 #: The gait axis; gait similarity is the number of steps along it (0 same, 1 near, >1 far).
 GAIT_AXIS = GAITS

@@ -31,15 +31,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
-import statsmodels.formula.api as smf
 from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import main_cycles
-from suds_exp.analysis.glm import glm_formulas, identifiable_columns
+from suds_exp.analysis.glm import formula_design, glm_formulas, glm_frame
 from suds_exp.errors import AnalysisError
+from suds_exp.models.registry import LEARNERS
 
-#: Learner names as stored in ``results.model``.
-PHASE, TLS, TLSS, GMR, GMRS = "phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS"
+#: The learners' roles in the findings (names as stored in ``results.model``).
+PHASE, TLS, TLSS, GMR, GMRS = LEARNERS
 #: A training size of at most this many cycles is "a few cycles" (F8).
 FEW_CYCLES = 3
 #: Verdicts, in the order a summary lists them.
@@ -264,28 +264,17 @@ class _GlmDesign:
 
 
 def _glm_design(labelled: pd.DataFrame, draw_index: pd.Series, main: int) -> _GlmDesign | None:
-    rows = labelled[(labelled["n_cycles"] == main) & ~labelled["phase_only"].astype(bool)]
-    rows = rows[np.isfinite(rows["rmse_vx"].to_numpy(float)) & (rows["rmse_vx"] > 0)]
-    rows = rows[rows["gait_sim"].notna()]
-    if len(rows) < 10 or rows["suds"].nunique() < 2 or rows["gmr"].nunique() < 2:
+    rows = labelled[labelled["n_cycles"] == main]
+    frame = glm_frame(rows[rows["gait_sim"].notna()])
+    if len(frame) < 10 or frame["suds"].nunique() < 2 or frame["gmr"].nunique() < 2:
         return None
-    frame = pd.DataFrame(
-        {
-            "y": 100.0 * np.log(rows["rmse_vx"].to_numpy(float)),
-            "suds": rows["suds"].astype(int).to_numpy(),
-            "gmr": rows["gmr"].astype(int).to_numpy(),
-            "period_rel": rows["period_rel"].astype(str).to_numpy(),
-            "gait_sim": rows["gait_sim"].astype(str).to_numpy(),
-        }
-    )
     direct, interactions, _ = glm_formulas(frame)
     exog, columns = {}, {}
     for label, formula in (("direct", direct), ("interactions", interactions)):
-        design = smf.ols(formula, frame)
-        keep = identifiable_columns(design.exog)
-        exog[label] = design.exog[:, keep]
-        columns[label] = [design.exog_names[j] for j in keep]
-    draw = draw_index.loc[rows.index].to_numpy()
+        design = formula_design(formula, frame)
+        exog[label] = design.exog[:, design.keep]
+        columns[label] = [design.names[j] for j in design.keep]
+    draw = draw_index.loc[frame.index].to_numpy()
     return _GlmDesign(draw, frame["y"].to_numpy(), exog, columns)
 
 

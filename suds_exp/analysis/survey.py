@@ -33,8 +33,9 @@ import pandas as pd
 from suds_exp.analysis.categories import learner_order
 from suds_exp.campaign.grid import KEY_COLUMNS
 from suds_exp.errors import AnalysisError
+from suds_exp.models.registry import GMR, MLP
 
-REFERENCE = "GMR"
+REFERENCE = GMR
 OWN_FACTOR = 1.25
 
 
@@ -129,7 +130,7 @@ def _pooled_cycles(rows, model, reference, main_cycles, metric) -> tuple[float, 
 
 def efficiency_ratio(
     results: pd.DataFrame,
-    model: str = "MLP",
+    model: str = MLP,
     reference: str = REFERENCE,
     main_cycles: int = 30,
     metric: str = "rmse_vx",
@@ -221,12 +222,8 @@ def learner_glm(
     much larger (in 100 ln units) its error is than GMR's in the reference category; an
     interaction is how much more (or less) than GMR it loses in that category.
     """
-    import statsmodels.api as sm
-    import statsmodels.formula.api as smf
-    from threadpoolctl import threadpool_limits
-
     from suds_exp.analysis.glm import REFERENCE as SIMILARITY_REFERENCE
-    from suds_exp.analysis.glm import identifiable_columns
+    from suds_exp.analysis.glm import fit_formula
 
     rows = results[results["n_cycles"] == main_cycles]
     frame = pd.DataFrame(
@@ -255,35 +252,13 @@ def learner_glm(
         "direct": "y ~ " + " + ".join(terms + similarity),
         "interactions": f"y ~ {terms[0]} * ({' + '.join(similarity)})",
     }
+    # terms the data cannot tell apart (e.g. same gait = same period when every condition
+    # has one frequency) are NaN, as R's lm reports NA (glm.py does too)
     tables = []
-    with threadpool_limits(limits=1, user_api="blas"):
-        for label, formula in formulas.items():
-            design = smf.ols(formula, frame)
-            names = design.exog_names
-            # terms the data cannot tell apart (e.g. same gait = same period when every
-            # condition has one frequency) are NaN, as R's lm reports NA (glm.py does too)
-            keep = identifiable_columns(design.exog)
-            fit = sm.OLS(design.endog, design.exog[:, keep]).fit()
-            coef, low, high, pval = (np.full(len(names), np.nan) for _ in range(4))
-            ci = np.asarray(fit.conf_int(alpha=alpha))
-            coef[keep], low[keep], high[keep], pval[keep] = (
-                fit.params,
-                ci[:, 0],
-                ci[:, 1],
-                fit.pvalues,
-            )
-            tables.append(
-                pd.DataFrame(
-                    {
-                        "model": label,
-                        "term": [_short_term(t) for t in names],
-                        "coef": coef,
-                        "ci_low": low,
-                        "ci_high": high,
-                        "p_value": pval,
-                    }
-                )
-            )
+    for label, formula in formulas.items():
+        fit = fit_formula(formula, frame, alpha)
+        term = fit.pop("column").map(_short_term)
+        tables.append(pd.concat([pd.DataFrame({"model": label, "term": term}), fit], axis=1))
     out = pd.concat(tables, ignore_index=True)
     out.attrs["n_rows"] = len(frame)
     out.attrs["formulas"] = formulas
@@ -307,7 +282,7 @@ SURVEY_COLUMNS = KEY_COLUMNS + (
 
 
 def survey_tables(
-    store, campaign: str, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
+    store, campaign: str, main_cycles: int = 30, n_boot: int = 1000, model: str = MLP
 ) -> dict:
     """Everything `suds-exp survey` prints: ``timing`` (`timing_table`); with a sweep,
     ``cycles`` (`cycles_to_target`) and ``ratio`` (`efficiency_ratio` of ``model`` against
@@ -320,7 +295,7 @@ def survey_tables(
 
 
 def survey_from_results(
-    results: pd.DataFrame, main_cycles: int = 30, n_boot: int = 1000, model: str = "MLP"
+    results: pd.DataFrame, main_cycles: int = 30, n_boot: int = 1000, model: str = MLP
 ) -> dict:
     """`survey_tables` of results already loaded (e.g. several campaigns pooled).
 

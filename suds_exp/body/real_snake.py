@@ -20,11 +20,12 @@ from suds_exp.body.description import load_body
 from suds_exp.body.prep import preprocess_body
 from suds_exp.ingest import ingest_paths
 from suds_exp.models import make_model
+from suds_exp.models.registry import GMR, PHASE_ONLY, TLS
 from suds_exp.preprocess import get_version
 from suds_exp.store import Store
 
 #: Learners compared on a chain (the +SUDS ones need passive states a snake has not).
-CHAIN_MODELS = ("phase-only", "TLS", "GMR")
+CHAIN_MODELS = (PHASE_ONLY, TLS, GMR)
 
 
 def holdout_errors(

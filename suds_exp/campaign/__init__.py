@@ -7,7 +7,7 @@ fills `results`; `campaign_status(store, name)` reports its progress (the small 
 
 from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import PAPER_SWEEP, parse_int_list
-from suds_exp.campaign.definition import LEARNERS, CampaignOptions
+from suds_exp.campaign.definition import CampaignOptions
 from suds_exp.campaign.grid import KEY_COLUMNS, Draw, enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, TIMING_COLUMNS
 from suds_exp.campaign.runner import RunSummary, run_campaign
@@ -16,7 +16,6 @@ from suds_exp.errors import CampaignError
 
 __all__ = [
     "KEY_COLUMNS",
-    "LEARNERS",
     "PAPER_SWEEP",
     "RESULT_COLUMNS",
     "TIMING_COLUMNS",

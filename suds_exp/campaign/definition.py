@@ -24,11 +24,9 @@ from suds_exp.campaign.conditions import (
 )
 from suds_exp.campaign.sampling import infeasible_cells
 from suds_exp.errors import CampaignError, ConfigError
-from suds_exp.robot import LEARNERS
+from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
 
 MODES = ("measured", "rollout")
-#: ``models="survey"``: the paper's five and the survey's scikit-learn baselines.
-SURVEY_LEARNERS = (*LEARNERS, "MLP", "MLP+SUDS", "GBT", "kNN", "KRR")
 DEFINITION_VERSION = 1
 
 

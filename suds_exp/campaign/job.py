@@ -21,6 +21,7 @@ from threadpoolctl import threadpool_limits
 from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.grid import KEY_COLUMNS, Draw
 from suds_exp.campaign.sampling import draw_sample
+from suds_exp.robot import VB_COLUMNS
 
 #: Columns of the `results` table, in order.
 RESULT_COLUMNS = KEY_COLUMNS + (
@@ -40,7 +41,6 @@ RESULT_COLUMNS = KEY_COLUMNS + (
 #: Columns that vary from run to run of the same job (everything else is reproducible).
 TIMING_COLUMNS = ("fit_seconds", "predict_seconds", "finished_at")
 
-VB = ("vx", "vy", "wz")
 Chunk = list[tuple[Draw, list[str]]]
 
 
@@ -118,7 +118,7 @@ def run_draw(
     sample = draw_sample(bank, draw, test_cycles)
     train = bank.frame([bank.rows(*r) for r in sample.train])
     test = bank.frame([bank.rows(*sample.test)])
-    truth = np.column_stack([test[c].to_numpy() for c in VB])
+    truth = np.column_stack([test[c].to_numpy() for c in VB_COLUMNS])
     ids = bank.trial_ids
     common = {
         "campaign": draw.campaign,
@@ -152,7 +152,7 @@ def run_draw(
             pred = model.predict(test.copy(deep=False))
             t2 = time.perf_counter()
             fit_s, predict_s = t1 - t0, t2 - t1
-            err = np.column_stack([pred[c].to_numpy(dtype=float) for c in VB]) - truth
+            err = np.column_stack([pred[c].to_numpy(dtype=float) for c in VB_COLUMNS]) - truth
             rmse = tuple(float(v) for v in np.sqrt(np.mean(err**2, axis=0)))
             if not np.all(np.isfinite(rmse)):
                 error = "prediction is not finite (NaN or inf), e.g. a diverging rollout"

@@ -10,7 +10,6 @@ from suds_exp.discrepancy.workflow import (
     DiscrepancyOptions,
     DiscrepancyResult,
     parse_exclude,
-    parse_trial_ids,
     run_discrepancy,
 )
 from suds_exp.errors import DiscrepancyError
@@ -27,6 +26,5 @@ __all__ = [
     "candidates_for",
     "parse_effect_items",
     "parse_exclude",
-    "parse_trial_ids",
     "run_discrepancy",
 ]

@@ -43,7 +43,6 @@ from suds_exp.errors import DiscrepancyError
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.version import get_version
 from suds_exp.progress import progress_lines
-from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 from suds_exp.sim.config import SimConfig
 from suds_exp.store.files import check_writable
 

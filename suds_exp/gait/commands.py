@@ -14,6 +14,7 @@ from suds_exp.gait.predict import decimate, fit_map, predict_gait
 from suds_exp.gait.shape import JOINT_LIMIT_RAD, read_gait_file
 from suds_exp.gait.trials import simulate_gait_file
 from suds_exp.models import make_model
+from suds_exp.models.registry import GMR
 from suds_exp.preprocess import get_version
 from suds_exp.sim import SimConfig, local_connection
 
@@ -23,7 +24,7 @@ def predict_command(
     gait_file: Path,
     frequency_hz: float,
     prep=None,
-    learner: str = "GMR",
+    learner: str = GMR,
     trials: Sequence[int] | None = None,
     n_boot: int = 10,
     bound: float = JOINT_LIMIT_RAD,
@@ -90,7 +91,7 @@ def connection_command(
     store,
     out: Path,
     prep=None,
-    learner: str = "GMR",
+    learner: str = GMR,
     grid: int = 21,
     half_range: float = 2.0,
     compare: bool = False,

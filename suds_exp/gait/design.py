@@ -47,6 +47,7 @@ from suds_exp.gait.support import Support
 from suds_exp.gait.trials import simulate_gait_file
 from suds_exp.gait.truth import simulate_gaits
 from suds_exp.models import make_model
+from suds_exp.models.registry import GMR
 from suds_exp.preprocess import get_version
 from suds_exp.preprocess import preprocess as run_preprocess
 from suds_exp.sim import SimConfig
@@ -66,7 +67,7 @@ class DesignOptions:
     cycles (of a verify trial).
     """
 
-    learner: str = "GMR"
+    learner: str = GMR
     bound: float = 1.3
     iterations: int = 5
     verify: bool = False

@@ -30,6 +30,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.gait.motion import CycleMotion, cycle_motion, integrate_twists
 from suds_exp.gait.shape import TWO_PI, Gait
 from suds_exp.models import make_model
+from suds_exp.models.registry import GMR
 from suds_exp.preprocess import get_version
 from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
 
@@ -153,7 +154,7 @@ class FittedMap:
 
 def fit_map(
     samples: pd.DataFrame,
-    learner: str = "GMR",
+    learner: str = GMR,
     params: dict | None = None,
     samples_per_cycle: int | None = None,
 ) -> FittedMap:
@@ -190,7 +191,7 @@ def predict_gaits(
     samples: pd.DataFrame,
     gaits: Sequence[Gait],
     frequency_hz: float,
-    learner: str = "GMR",
+    learner: str = GMR,
     params: dict | None = None,
     n_boot: int = 0,
     seed: int = 0,

@@ -1,5 +1,7 @@
 """The five learners of the paper, built by name with `make_model`.
 
+Every learner's name, family, SUDS flag and tags are in `registry.REGISTRY`.
+
 | name         | class                          | learns                                   |
 |--------------|--------------------------------|------------------------------------------|
 | `phase-only` | `phase_only.PhaseOnly`         | v_b(phase), Fourier series               |
@@ -28,25 +30,21 @@ from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
-from suds_exp.models.sklearn_adapter import SklearnLearner, baseline_names, make_adapter, recipe
+from suds_exp.models.registry import BASELINE_LEARNERS, LEARNERS, ONLINE_LEARNERS
+from suds_exp.models.sklearn_adapter import SklearnLearner, make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
 
-MODELS: dict[str, type[Learner]] = {
-    "phase-only": PhaseOnly,
-    "TLS": TLS,
-    "TLS+SUDS": TLSSuds,
-    "GMR": GMR,
-    "GMR+SUDS": GMRSuds,
-}
-MODEL_NAMES = tuple(MODELS)
+#: The paper's five by name (`registry.LEARNERS`, in its order).
+MODELS: dict[str, type[Learner]] = dict(
+    zip(LEARNERS, (PhaseOnly, TLS, TLSSuds, GMR, GMRSuds), strict=True)
+)
+MODEL_NAMES = LEARNERS
 #: Learners with `partial_fit(samples)`; kept out of MODEL_NAMES (the paper's five).
-ONLINE_MODELS: dict[str, type[Learner]] = {
-    "OnlineGMR": OnlineGMR,
-    "OnlineGMR+SUDS": OnlineGMRSuds,
-    "GradualGMR+SUDS": GradualGMRSuds,
-}
+ONLINE_MODELS: dict[str, type[Learner]] = dict(
+    zip(ONLINE_LEARNERS, (OnlineGMR, OnlineGMRSuds, GradualGMRSuds), strict=True)
+)
 #: The survey's named baselines (scikit-learn regressors with documented defaults).
-BASELINE_NAMES = baseline_names()
+BASELINE_NAMES = BASELINE_LEARNERS
 
 
 def make_model(name: str, **params) -> Learner:

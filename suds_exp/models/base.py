@@ -18,7 +18,7 @@ import pandas as pd
 from sklearn.base import BaseEstimator
 
 from suds_exp.errors import ConfigError, ModelError
-from suds_exp.robot import DRA_COLUMNS, RA_COLUMNS, VB_COLUMNS  # noqa: F401  (also imported from here)
+from suds_exp.robot import RA_COLUMNS, VB_COLUMNS
 
 _RP_PATTERN = re.compile(r"^rp_(\d+)$")
 _RA_PATTERN = re.compile(r"^ra_(\d+)$")

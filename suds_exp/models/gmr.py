@@ -80,13 +80,13 @@ so the cost of a campaign is predictable.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
-    RA_COLUMNS,
-    VB_COLUMNS,
     Learner,
     ModelError,
     TimeSeries,
@@ -106,6 +106,7 @@ from suds_exp.models.mixture import (
     responsibilities,
     row_max,
 )
+from suds_exp.robot import RA_COLUMNS, VB_COLUMNS
 
 
 def history_features(
@@ -148,6 +149,33 @@ def forward_filter(log_emit, transition, priors, first) -> np.ndarray:
         a = a / s if s > 0 else e[t] * priors / (e[t] @ priors)
         out[t] = a
     return out
+
+
+@dataclass(frozen=True)
+class GMRDefaults:
+    """GMR's hyper-parameter defaults, the one home of each: `GMR`, `GMRSuds` and the
+    online learners (`online.py`, `gradual.py`) take theirs from `GMR_DEFAULTS`."""
+
+    n_components: int = 16
+    reg_covar: float = 1e-3
+    max_iter: int = 60
+    tol: float = 1e-3
+    augment: str = "homogeneous"
+    augment_range: tuple = (0.5, 2.0)
+    augment_copies: int = 1
+    augment_weight: float = 0.5
+    augment_power: float = 1.0
+    speed_floor: float = 0.1
+    branching: str = "none"
+    branch_mix: float = 0.1
+    branch_memory: float = 1.0
+    select_k: str = "none"
+    k_candidates: tuple = (4, 8, 12, 16)
+    random_state: int = 0
+    mode: str = "measured"
+
+
+GMR_DEFAULTS = GMRDefaults()
 
 
 class GMR(Learner):
@@ -199,22 +227,22 @@ class GMR(Learner):
 
     def __init__(
         self,
-        n_components: int = 16,
-        reg_covar: float = 1e-3,
-        max_iter: int = 60,
-        tol: float = 1e-3,
-        augment: str = "homogeneous",
-        augment_range: tuple = (0.5, 2.0),
-        augment_copies: int = 1,
-        augment_weight: float = 0.5,
-        augment_power: float = 1.0,
-        speed_floor: float = 0.1,
-        branching: str = "none",
-        branch_mix: float = 0.1,
-        branch_memory: float = 1.0,
-        select_k: str = "none",
-        k_candidates: tuple = (4, 8, 12, 16),
-        random_state: int = 0,
+        n_components: int = GMR_DEFAULTS.n_components,
+        reg_covar: float = GMR_DEFAULTS.reg_covar,
+        max_iter: int = GMR_DEFAULTS.max_iter,
+        tol: float = GMR_DEFAULTS.tol,
+        augment: str = GMR_DEFAULTS.augment,
+        augment_range: tuple = GMR_DEFAULTS.augment_range,
+        augment_copies: int = GMR_DEFAULTS.augment_copies,
+        augment_weight: float = GMR_DEFAULTS.augment_weight,
+        augment_power: float = GMR_DEFAULTS.augment_power,
+        speed_floor: float = GMR_DEFAULTS.speed_floor,
+        branching: str = GMR_DEFAULTS.branching,
+        branch_mix: float = GMR_DEFAULTS.branch_mix,
+        branch_memory: float = GMR_DEFAULTS.branch_memory,
+        select_k: str = GMR_DEFAULTS.select_k,
+        k_candidates: tuple = GMR_DEFAULTS.k_candidates,
+        random_state: int = GMR_DEFAULTS.random_state,
     ):
         self.n_components = n_components
         self.reg_covar = reg_covar
@@ -403,23 +431,23 @@ class GMRSuds(GMR):
 
     def __init__(
         self,
-        n_components: int = 16,
-        reg_covar: float = 1e-3,
-        max_iter: int = 60,
-        tol: float = 1e-3,
-        augment: str = "homogeneous",
-        augment_range: tuple = (0.5, 2.0),
-        augment_copies: int = 1,
-        augment_weight: float = 0.5,
-        augment_power: float = 1.0,
-        speed_floor: float = 0.1,
-        branching: str = "none",
-        branch_mix: float = 0.1,
-        branch_memory: float = 1.0,
-        select_k: str = "none",
-        k_candidates: tuple = (4, 8, 12, 16),
-        random_state: int = 0,
-        mode: str = "measured",
+        n_components: int = GMR_DEFAULTS.n_components,
+        reg_covar: float = GMR_DEFAULTS.reg_covar,
+        max_iter: int = GMR_DEFAULTS.max_iter,
+        tol: float = GMR_DEFAULTS.tol,
+        augment: str = GMR_DEFAULTS.augment,
+        augment_range: tuple = GMR_DEFAULTS.augment_range,
+        augment_copies: int = GMR_DEFAULTS.augment_copies,
+        augment_weight: float = GMR_DEFAULTS.augment_weight,
+        augment_power: float = GMR_DEFAULTS.augment_power,
+        speed_floor: float = GMR_DEFAULTS.speed_floor,
+        branching: str = GMR_DEFAULTS.branching,
+        branch_mix: float = GMR_DEFAULTS.branch_mix,
+        branch_memory: float = GMR_DEFAULTS.branch_memory,
+        select_k: str = GMR_DEFAULTS.select_k,
+        k_candidates: tuple = GMR_DEFAULTS.k_candidates,
+        random_state: int = GMR_DEFAULTS.random_state,
+        mode: str = GMR_DEFAULTS.mode,
     ):
         super().__init__(
             n_components,

@@ -28,9 +28,6 @@ from scipy.special import logsumexp
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
-    DRA_COLUMNS,
-    RA_COLUMNS,
-    VB_COLUMNS,
     Learner,
     ModelError,
     as_array,
@@ -39,7 +36,9 @@ from suds_exp.models.base import (
     passive_columns,
     require_columns,
 )
-from suds_exp.models.online import OnlineGMR
+from suds_exp.models.gmr import GMR_DEFAULTS
+from suds_exp.models.online import ONLINE_DEFAULTS, OnlineGMR
+from suds_exp.robot import DRA_COLUMNS, RA_COLUMNS, VB_COLUMNS
 
 _LOG_2PI = np.log(2 * np.pi)
 
@@ -112,16 +111,16 @@ class GradualGMRSuds(Learner):
 
     def __init__(
         self,
-        n_components: int = 16,
-        reg_covar: float = 1e-3,
-        forgetting: float = 0.002,
-        warmup_samples: int = 500,
-        sweeps: int = 2,
-        min_share: float = 0.05,
+        n_components: int = GMR_DEFAULTS.n_components,
+        reg_covar: float = GMR_DEFAULTS.reg_covar,
+        forgetting: float = ONLINE_DEFAULTS.forgetting,
+        warmup_samples: int = ONLINE_DEFAULTS.warmup_samples,
+        sweeps: int = ONLINE_DEFAULTS.sweeps,
+        min_share: float = ONLINE_DEFAULTS.min_share,
         window: int = 10,
         min_gain: float = 0.05,
         min_t: float = 3.0,
-        random_state: int = 0,
+        random_state: int = GMR_DEFAULTS.random_state,
     ):
         self.n_components = n_components
         self.reg_covar = reg_covar

@@ -35,6 +35,8 @@ machine; most of it is pandas column handling, not EM.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pandas as pd
 from scipy.special import logsumexp
@@ -50,8 +52,22 @@ from suds_exp.models.base import (
     require_columns,
     rollout_bounds,
 )
-from suds_exp.models.gmr import GMR, GMRSuds
+from suds_exp.models.gmr import GMR, GMR_DEFAULTS, GMRSuds
 from suds_exp.models.mixture import Conditional, fit_mixture, log_gaussians
+
+
+@dataclass(frozen=True)
+class OnlineDefaults:
+    """Defaults of the online learners' own hyper-parameters, the one home of each
+    (`OnlineGMR`, `OnlineGMRSuds`, `gradual.GradualGMRSuds`); the rest are `GMR_DEFAULTS`."""
+
+    forgetting: float = 0.002
+    warmup_samples: int = 500
+    sweeps: int = 2
+    min_share: float = 0.05
+
+
+ONLINE_DEFAULTS = OnlineDefaults()
 
 
 class _OnlineMixin:
@@ -62,7 +78,7 @@ class _OnlineMixin:
     select_k = "none"
     augment_copies = 0
     augment_weight = 0.0
-    augment_range = (0.5, 2.0)
+    augment_range = GMR_DEFAULTS.augment_range
     branch_mix = 0.0
     branch_memory = 1.0
     k_candidates = ()
@@ -282,18 +298,18 @@ class OnlineGMR(_OnlineMixin, GMR):
 
     def __init__(
         self,
-        n_components: int = 16,
-        reg_covar: float = 1e-3,
-        max_iter: int = 60,
-        tol: float = 1e-3,
-        augment: str = "homogeneous",
-        augment_power: float = 1.0,
-        speed_floor: float = 0.1,
-        forgetting: float = 0.002,
-        warmup_samples: int = 500,
-        sweeps: int = 2,
-        min_share: float = 0.05,
-        random_state: int = 0,
+        n_components: int = GMR_DEFAULTS.n_components,
+        reg_covar: float = GMR_DEFAULTS.reg_covar,
+        max_iter: int = GMR_DEFAULTS.max_iter,
+        tol: float = GMR_DEFAULTS.tol,
+        augment: str = GMR_DEFAULTS.augment,
+        augment_power: float = GMR_DEFAULTS.augment_power,
+        speed_floor: float = GMR_DEFAULTS.speed_floor,
+        forgetting: float = ONLINE_DEFAULTS.forgetting,
+        warmup_samples: int = ONLINE_DEFAULTS.warmup_samples,
+        sweeps: int = ONLINE_DEFAULTS.sweeps,
+        min_share: float = ONLINE_DEFAULTS.min_share,
+        random_state: int = GMR_DEFAULTS.random_state,
     ):
         self.n_components = n_components
         self.reg_covar = reg_covar
@@ -319,19 +335,19 @@ class OnlineGMRSuds(_OnlineMixin, GMRSuds):
 
     def __init__(
         self,
-        n_components: int = 16,
-        reg_covar: float = 1e-3,
-        max_iter: int = 60,
-        tol: float = 1e-3,
-        augment: str = "homogeneous",
-        augment_power: float = 1.0,
-        speed_floor: float = 0.1,
-        forgetting: float = 0.002,
-        warmup_samples: int = 500,
-        sweeps: int = 2,
-        min_share: float = 0.05,
-        random_state: int = 0,
-        mode: str = "measured",
+        n_components: int = GMR_DEFAULTS.n_components,
+        reg_covar: float = GMR_DEFAULTS.reg_covar,
+        max_iter: int = GMR_DEFAULTS.max_iter,
+        tol: float = GMR_DEFAULTS.tol,
+        augment: str = GMR_DEFAULTS.augment,
+        augment_power: float = GMR_DEFAULTS.augment_power,
+        speed_floor: float = GMR_DEFAULTS.speed_floor,
+        forgetting: float = ONLINE_DEFAULTS.forgetting,
+        warmup_samples: int = ONLINE_DEFAULTS.warmup_samples,
+        sweeps: int = ONLINE_DEFAULTS.sweeps,
+        min_share: float = ONLINE_DEFAULTS.min_share,
+        random_state: int = GMR_DEFAULTS.random_state,
+        mode: str = GMR_DEFAULTS.mode,
     ):
         self.n_components = n_components
         self.reg_covar = reg_covar

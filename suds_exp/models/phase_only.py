@@ -9,7 +9,13 @@ from __future__ import annotations
 import pandas as pd
 
 from suds_exp.models import fourier
-from suds_exp.models.base import VB_COLUMNS, Learner, as_array, check_int, require_columns
+from suds_exp.models.base import (
+    Learner,
+    as_array,
+    check_int,
+    require_columns,
+)
+from suds_exp.robot import VB_COLUMNS
 
 
 class PhaseOnly(Learner):

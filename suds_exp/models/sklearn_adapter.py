@@ -39,7 +39,6 @@ from sklearn.preprocessing import StandardScaler
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
-    VB_COLUMNS,
     Learner,
     ModelError,
     TimeSeries,
@@ -51,9 +50,10 @@ from suds_exp.models.base import (
     require_columns,
     rollout_bounds,
 )
+from suds_exp.models.registry import SUDS_SUFFIX
+from suds_exp.robot import VB_COLUMNS
 
 PREFIX = "sklearn:"
-SUDS_SUFFIX = "+SUDS"
 #: Keyword arguments of `make_model` that configure the adapter, not the estimator.
 ADAPTER_PARAMS = ("homogeneous", "speed_floor", "standardize", "mode", "random_state", "dtype")
 #: Floating-point types the estimator may be given its arrays in.
@@ -492,10 +492,6 @@ BASELINES: dict[str, tuple] = {
 }
 
 
-def baseline_names() -> tuple[str, ...]:
-    return tuple(n for b in BASELINES for n in (b, b + SUDS_SUFFIX))
-
-
 def split_name(name: str) -> tuple[str, bool]:
     """(name without +SUDS, whether it had it)."""
     if name.endswith(SUDS_SUFFIX):
@@ -529,7 +525,6 @@ __all__ = [
     "BASELINES",
     "SklearnLearner",
     "actuated_columns",
-    "baseline_names",
     "make_adapter",
     "recipe",
 ]

@@ -42,7 +42,6 @@ import pandas as pd
 from suds_exp.errors import ConfigError
 from suds_exp.models import fourier
 from suds_exp.models.base import (
-    VB_COLUMNS,
     Learner,
     ModelError,
     TimeSeries,
@@ -56,6 +55,7 @@ from suds_exp.models.base import (
     require_columns,
     rollout_bounds,
 )
+from suds_exp.robot import VB_COLUMNS
 
 _TWO_PI = 2.0 * np.pi
 

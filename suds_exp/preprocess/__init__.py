@@ -6,7 +6,6 @@ from suds_exp.preprocess.params import (
     DEFAULTS,
     PRESETS,
     parse_param_items,
-    parse_trial_ids,
     preset_params,
     resolve_params,
 )
@@ -28,7 +27,6 @@ __all__ = [
     "list_versions",
     "load_samples",
     "parse_param_items",
-    "parse_trial_ids",
     "preprocess",
     "preset_params",
     "resolve_params",

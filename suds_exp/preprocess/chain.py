@@ -42,9 +42,14 @@ from suds_exp.preprocess.rates import local_polynomial, window_frames
 from suds_exp.robot import ROLES
 
 _ROLE = {role: i for i, role in enumerate(ROLES)}
-#: Rigid markers of each outer segment and the tail's flipper markers (hinged).
+#: Rigid markers of each outer segment (also of `kinematics`' rigid tail fit,
+#: ``tail_fit="rigid"``; the head has only its two top markers: its spoke rings on its
+#: skewer).
 HEAD_RIGID = ("head_top_1", "head_top_2")
 TAIL_RIGID = ("tail_top_1", "tail_top_2", "tail_back")
+#: Markers on the tail's flippers (``tail_fit="rigid+flippers"``): each moves on a circle
+#: about its hinge, fixed in the tail frame. The head's flippers open by at most ~0.45 rad
+#: on the simulator, too little arc for a well-determined circle.
 TAIL_HINGED = ("flipper_3", "flipper_4")
 
 

@@ -17,7 +17,7 @@ from suds_exp.preprocess.body_frame import (
     rigid_fit,
     segment_frames,
 )
-from suds_exp.preprocess.chain import chain_pose
+from suds_exp.preprocess.chain import TAIL_HINGED, TAIL_RIGID, chain_pose
 from suds_exp.preprocess.params import TAIL_FITS
 from suds_exp.preprocess.shape import ACTUATED_SHAPES, PASSIVE_ROLES, passive_state
 from suds_exp.robot import ROLES, SPOKE_ROLES
@@ -36,15 +36,6 @@ class Measured:
     plane: Plane
     local: np.ndarray
     frames: SegmentFrames
-
-
-#: Tail markers of the rigid tail fit (``tail_fit="rigid"``); the head has only its two
-#: top markers (its spoke rings on its skewer).
-TAIL_RIGID = ("tail_top_1", "tail_top_2", "tail_back")
-#: Markers on the tail's flippers (``tail_fit="rigid+flippers"``): each moves on a circle
-#: about its hinge, fixed in the tail frame. The head's flippers open by at most ~0.45 rad
-#: on the simulator, too little arc for a well-determined circle.
-TAIL_HINGED = ("flipper_3", "flipper_4")
 
 
 def measure(xyz: np.ndarray, tail_fit: str = "rigid+flippers") -> Measured:

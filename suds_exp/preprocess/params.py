@@ -14,7 +14,6 @@ from typing import Any
 
 from suds_exp.errors import ConfigError
 from suds_exp.robot import MAX_K
-from suds_exp.robot import parse_ids as parse_trial_ids  # noqa: F401  (its old import path)
 
 #: Every parameter, its default and meaning (units in the name or the text).
 DEFAULTS: dict[str, Any] = {

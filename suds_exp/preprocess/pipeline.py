@@ -35,7 +35,6 @@ from suds_exp.preprocess.tables import (
     prep_trials,
     prep_versions,
 )
-from suds_exp.preprocess.version import load_samples  # noqa: F401  (its old import path)
 from suds_exp.preprocess.version import require_tables as _require_tables
 from suds_exp.progress import progress_bar
 from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS

@@ -6,9 +6,10 @@ import pandas as pd
 
 from suds_exp.campaign.bank import SampleBank, rounded_conditions
 from suds_exp.campaign.conditions import GAITS, format_condition
-from suds_exp.campaign.definition import LEARNERS, CampaignOptions
+from suds_exp.campaign.definition import CampaignOptions
 from suds_exp.campaign.runner import RunSummary, run_campaign
 from suds_exp.errors import CampaignError
+from suds_exp.models.registry import LEARNERS
 from suds_exp.store import Store
 
 #: Gaits the demo prefers, in order: with them the pairs cover every gait similarity

@@ -14,7 +14,16 @@ import json
 import numpy as np
 import pandas as pd
 
-from suds_exp.analysis.categories import GAIT_AXIS, LEARNERS
+from suds_exp.analysis.categories import GAIT_AXIS
+from suds_exp.models.registry import (
+    GMR,
+    GMR_SUDS,
+    LEARNERS,
+    PHASE_ONLY,
+    SUDS_SUFFIX,
+    TLS,
+    TLS_SUDS,
+)
 from suds_exp.robot import FREQUENCIES_HZ
 
 #: The paper's first-order-interactions GLM (its Table "GLM coefficient comparison"), used
@@ -43,13 +52,13 @@ PAPER_INTERACTIONS = {
 }
 
 #: Default log-log slopes of RMS error against training cycles.
-DEFAULT_SLOPES = {"phase-only": 0.0, "TLS": -0.05, "TLS+SUDS": -0.1, "GMR": -0.3, "GMR+SUDS": -0.5}
+DEFAULT_SLOPES = {PHASE_ONLY: 0.0, TLS: -0.05, TLS_SUDS: -0.1, GMR: -0.3, GMR_SUDS: -0.5}
 
 
 def _indicators(frame: pd.DataFrame) -> dict[str, np.ndarray]:
     return {
-        "SUDS": frame["model"].str.endswith("+SUDS").to_numpy(),
-        "GMR": frame["model"].str.startswith("GMR").to_numpy(),
+        "SUDS": frame["model"].str.endswith(SUDS_SUFFIX).to_numpy(),
+        "GMR": frame["model"].str.startswith(GMR).to_numpy(),
         "model-period<data-period": (
             frame["train_frequency_hz"] > frame["test_frequency_hz"] + 1e-9
         ).to_numpy(),
@@ -137,7 +146,7 @@ def synthetic_results(
     y = np.zeros(len(grid))
     for term, coef in effects.items():
         y += coef * term_indicator(term, basic)
-    phase_only = (grid["model"] == "phase-only").to_numpy()
+    phase_only = (grid["model"] == PHASE_ONLY).to_numpy()
     y[phase_only] = effects.get("Intercept", 0.0) + phase_only_offset
     slope = grid["model"].map(slopes).fillna(0.0).to_numpy()
     y += 100.0 * slope * np.log(grid["n_cycles"].to_numpy() / max(n_cycles))

@@ -1,0 +1,92 @@
+"""The learner registry is the one home of learner names (issue 29)."""
+
+from __future__ import annotations
+
+import pytest
+
+from suds_exp.campaign.definition import CampaignOptions
+from suds_exp.models import BASELINE_NAMES, MODEL_NAMES, ONLINE_MODELS, make_model
+from suds_exp.models.registry import (
+    LEARNERS,
+    REGISTRY,
+    SUDS_SUFFIX,
+    SURVEY_LEARNERS,
+    tagged,
+)
+from suds_exp.models.sklearn_adapter import BASELINES
+
+
+def test_the_paper_five_in_its_order():
+    assert LEARNERS == ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
+    assert MODEL_NAMES == LEARNERS
+
+
+def test_survey_is_the_five_and_the_baselines_it_names():
+    assert SURVEY_LEARNERS == (*LEARNERS, "MLP", "MLP+SUDS", "GBT", "kNN", "KRR")
+    assert list(CampaignOptions.parse(models="survey").models) == list(SURVEY_LEARNERS)
+
+
+def test_baselines_and_online_learners_match_their_builders():
+    assert BASELINE_NAMES == tuple(n for b in BASELINES for n in (b, b + SUDS_SUFFIX))
+    assert tagged("online") == tuple(ONLINE_MODELS)
+
+
+@pytest.mark.parametrize("info", REGISTRY, ids=lambda i: i.name)
+def test_every_entry_builds_and_its_suds_flag_matches_its_name(info):
+    make_model(info.name)
+    assert info.suds == info.name.endswith(SUDS_SUFFIX)
+    assert info.family in info.name
+
+
+def test_unknown_tag_is_refused():
+    with pytest.raises(ValueError, match="expected one of"):
+        tagged("papers")
+
+
+def test_the_sql_vocabulary_table_equals_the_registry(tmp_path):
+    from suds_exp.store import Store
+
+    store = Store(tmp_path / "x.duckdb")
+    store.upgrade()
+    table = store.query_df("SELECT * FROM learners ORDER BY name")
+    want = sorted(
+        (
+            i.name,
+            i.family,
+            i.suds,
+            *(t in i.tags for t in ("paper", "survey", "online", "baseline")),
+        )
+        for i in REGISTRY
+    )
+    got = [tuple(row) for row in table.itertuples(index=False)]
+    assert [(r[0], r[1], *map(bool, r[2:])) for r in got] == want
+    assert list(table.columns) == [
+        "name",
+        "family",
+        "suds",
+        "paper",
+        "survey",
+        "online",
+        "baseline",
+    ]
+
+
+def test_the_labels_of_every_learner_name_are_as_before(tmp_path):
+    """suds / gmr / phase_only of `results_labelled`, read from `learners`, equal migration
+    004's name patterns for every registered name and a scikit-learn one."""
+    from suds_exp.store import Store
+    from suds_exp.testing.synthetic_results import synthetic_results
+
+    store = Store(tmp_path / "x.duckdb")
+    names = [i.name for i in REGISTRY] + ["sklearn:Ridge", "sklearn:Ridge+SUDS"]
+    rows = synthetic_results("names", n_boot=1, models=names, seed=3)
+    with store.write() as conn:
+        store.insert_df(conn, "results", rows)
+    frame = store.query_df(
+        "SELECT DISTINCT model, suds, gmr, phase_only FROM results_labelled ORDER BY model"
+    )
+    assert sorted(frame.model) == sorted(names)
+    for row in frame.itertuples(index=False):
+        assert bool(row.suds) == row.model.endswith("+SUDS"), row
+        assert bool(row.gmr) == row.model.startswith("GMR"), row
+        assert bool(row.phase_only) == (row.model == "phase-only"), row
