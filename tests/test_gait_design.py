@@ -182,3 +182,13 @@ def test_bad_options_are_one_line_and_leave_the_db_unchanged(db, tmp_path, args)
     assert r.exit_code == 2, r.output
     assert len(r.stderr.strip().splitlines()) == 1
     assert_same_db(before, dump_db(db))
+
+
+def test_the_designer_s_tilted_start_is_the_phase_shifted_ellipse():
+    from suds_exp.gait.design import LAGS_RAD, circle
+
+    theta = np.linspace(0.0, 2 * np.pi, 50)
+    for lag in LAGS_RAD:
+        np.testing.assert_allclose(
+            circle(1.0, 2, lag=lag).shape(theta), ellipse(1.0, 1.0, lag).shape(theta), atol=1e-12
+        )

@@ -23,7 +23,7 @@ Every iteration is stored in ``gait_design_iterations`` (migration 017).
 
 The optimiser is Nelder-Mead with penalties (a fitted map is cheap, a few ms a gait, but
 not smooth enough for gradients), started from the best gait so far and from the paper's
-circle O.
+circle O, plain and tilted either way (`LAGS_RAD`).
 """
 
 from __future__ import annotations
@@ -53,6 +53,11 @@ from suds_exp.preprocess import preprocess as run_preprocess
 from suds_exp.sim import SimConfig
 from suds_exp.store import Store
 
+#: Joint lags (rad) of the multi-start circles: the one-harmonic gaits span amplitude and
+#: lag; a local search from the circle alone stays near it, so the search also starts
+#: from the circle tilted either way (each pulled inside the trust region first).
+LAGS_RAD = (-0.6, 0.0, 0.6)
+
 #: Penalty (mm of forward displacement) per rad beyond the bound or the trust radius.
 PENALTY_MM_PER_RAD = 500.0
 
@@ -62,7 +67,7 @@ class DesignOptions:
     """The recipe of a design run (stored as its definition).
 
     bound (rad), frequency_hz (Hz), order (Fourier harmonics), trust0 (rad, first trust
-    radius), trust_max (rad), grow / shrink (radius factors), accept_error (relative
+    radius), trust_max (rad), grow / grow_fast / shrink (radius factors), accept_error (relative
     prediction error that counts as trusted), max_evals (map evaluations per start),
     cycles (of a verify trial).
     """
@@ -76,6 +81,7 @@ class DesignOptions:
     trust0: float = 0.15
     trust_max: float = 0.4
     grow: float = 1.5
+    grow_fast: float = 2.0
     shrink: float = 0.5
     accept_error: float = 0.2
     max_evals: int = 400
@@ -140,11 +146,14 @@ class Design:
         }
 
 
-def circle(radius: float, order: int, name: str = "circle") -> FourierGait:
-    """phi1 = r cos, phi2 = r sin (the paper's O at r = 1) with ``order`` harmonics."""
+def circle(radius: float, order: int, name: str = "circle", lag: float = 0.0) -> FourierGait:
+    """phi1 = r cos t, phi2 = r sin(t + lag) (the paper's O at r = 1, lag = 0) with
+    ``order`` harmonics; a lag (rad) tilts the circle into an ellipse."""
     a = np.zeros((order, 2))
     b = np.zeros((order, 2))
-    a[0, 0] = b[0, 1] = radius
+    a[0, 0] = radius
+    a[0, 1] = radius * np.sin(lag)
+    b[0, 1] = radius * np.cos(lag)
     return FourierGait([0.0, 0.0], a, b, name)
 
 
@@ -232,7 +241,8 @@ def design_gait(
         support = Support.of(decimate(samples))
         name = f"design-{design_id}-it{it}.toml"
         starts = [
-            _fit_inside(g, support, opts.bound, trust) for g in (best, circle(1.0, opts.order))
+            _fit_inside(g, support, opts.bound, trust)
+            for g in (best, *(circle(1.0, opts.order, lag=d) for d in LAGS_RAD))
         ]
         gait, _ = optimise_gait(
             lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
@@ -255,9 +265,7 @@ def design_gait(
                 abs(achieved.forward_mm), 1e-9
             )
             used = trust
-            trust = min(
-                opts.trust_max, trust * (opts.grow if error <= opts.accept_error else opts.shrink)
-            )
+            trust = min(opts.trust_max, trust * _radius_factor(error, opts))
             if achieved.forward_mm > best_achieved:
                 best, best_achieved = gait, achieved.forward_mm
             samples = version.samples()
@@ -281,6 +289,15 @@ def design_gait(
         if progress is not None:
             progress(record)
     return design
+
+
+def _radius_factor(error: float, opts: DesignOptions) -> float:
+    """The trust radius's factor after a verified step with relative prediction error
+    ``error``: the classical rule with a very-successful tier (grow twice when the map
+    was right within half the accepted error), shrink when it was wrong."""
+    if error <= opts.accept_error / 2:
+        return opts.grow_fast
+    return opts.grow if error <= opts.accept_error else opts.shrink
 
 
 def _verify_trial(store, version, gait, opts, out, design_id, it, config) -> int:
