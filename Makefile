@@ -55,4 +55,4 @@ wheel-check: $(STAMP)
 	PY=$(PY) bash .ci/wheel_check.sh
 
 clean:
-	rm -rf $(VENV) *.duckdb reports/*/ sim-data site
+	rm -rf $(VENV) *.duckdb *.duckdb.lock reports/*/ sim-data site
