@@ -160,7 +160,7 @@ def preprocessing_parameters() -> str:
     out, section, previous = [], None, ""
     for sec, key, text in rows:
         if sec != section:
-            out += ["", f"### {sec[0].upper() + sec[1:]}", "", "| parameter | default | meaning |"]
+            out += ["", f"## {sec[0].upper() + sec[1:]}", "", "| parameter | default | meaning |"]
             out.append("|---|---|---|")
             section = sec
         text = text or f"see `{previous}` above"
