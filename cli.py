@@ -161,15 +161,10 @@ def ingest(
 @command()
 def trials(db: DbOption = None, json_: JsonOption = False) -> None:
     """List the trials and their conditions."""
+    from suds_exp.commands.ingest import print_trials
     from suds_exp.ingest import list_trials
 
-    frame = list_trials(open_store(db))
-    if json_:
-        console.print_json(frame)
-    else:
-        shown = frame.drop(columns=["source_file", "ingested_at"])
-        shown.insert(1, "file", frame.source_file.map(lambda p: Path(p).name))
-        console.print_frame(shown, title="trials")
+    print_trials(list_trials(open_store(db)), json_)
 
 
 @command()
@@ -453,21 +448,14 @@ def survey(
 
     Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
     """
-    from suds_exp.analysis.survey import ratio_sentence, survey_json, survey_tables
+    from suds_exp.analysis.survey import survey_json, survey_tables
+    from suds_exp.commands.survey import print_survey
 
     tables = survey_tables(open_store(db), name, cycles, n_boot, versus)
     if json_:
         console.print_json(survey_json(tables))
-        return
-    if "cycles" in tables:
-        console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
-    console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
-    if "glm" in tables:
-        console.print_frame(tables["glm"].round(3), title="GLM, learner as a factor (100 ln)")
-    if "ratio" in tables:
-        console.out.print(ratio_sentence(tables["ratio"], cycles))
-    for why in tables.get("missing", []):
-        console.out.print(f"left out: {user_message(why)}")
+    else:
+        print_survey(tables, cycles)
 
 
 @command()
@@ -708,7 +696,7 @@ def gait_predict(
 
     Example: suds-exp gait predict --gait-file ellipse.toml --freq 1/2 --learner GMR --json
     """
-    from suds_exp.commands.gait import predict_command
+    from suds_exp.commands.gait import predict_command, predict_text
     from suds_exp.commands.simulate import parse_freqs
     from suds_exp.robot import parse_ids
 
@@ -718,15 +706,8 @@ def gait_predict(
     )
     if json_:
         console.print_json(doc)
-        return
-    ci = doc["interval"].get("forward_mm")
-    console.out.print(
-        f"{doc['gait']} at {doc['frequency_hz']:g} Hz ({learner}): forward "
-        f"{doc['forward_mm']:.1f} mm/cycle"
-        + (f" [{ci[0]:.1f}, {ci[1]:.1f}]" if ci else "")
-        + f", lateral {doc['lateral_mm']:.1f} mm, turn {doc['turn_rad']:.3f} rad, "
-        f"mean vx {doc['mean_vx_mm_s']:.1f} mm/s"
-    )
+    else:
+        console.out.print(predict_text(doc, learner))
 
 
 @command(on=gait_app, name="design", flags={"frequency_hz": "--freq"})
@@ -753,7 +734,7 @@ def gait_design(
     Every iteration is stored (table gait_design_iterations).
     Example: suds-exp gait design --bound 1.3 --iterations 5 --verify --json
     """
-    from suds_exp.commands.gait import design_command
+    from suds_exp.commands.gait import design_command, iteration_text
     from suds_exp.commands.simulate import build_config, parse_freqs
     from suds_exp.gait.design import DesignOptions
 
@@ -766,14 +747,7 @@ def gait_design(
         order=order,
     )
 
-    def say(it) -> None:
-        if not json_:
-            ach = f", achieved {it.achieved.forward_mm:.1f}" if it.achieved else ""
-            console.out.print(
-                f"iteration {it.iteration}: predicted {it.predicted.forward_mm:.1f} mm/cycle"
-                f"{ach}; trust radius {it.trust_radius:.3f} ({it.seconds:.0f} s)"
-            )
-
+    say = None if json_ else (lambda it: console.out.print(iteration_text(it)))
     doc = design_command(
         open_store(db), prep, options, out, build_config(config, []) if config else None, say
     )
@@ -805,7 +779,7 @@ def gait_connection(
 
     Example: suds-exp gait connection --out reports/learned.csv --compare
     """
-    from suds_exp.commands.gait import connection_command
+    from suds_exp.commands.gait import connection_command, connection_lines
     from suds_exp.commands.simulate import build_config
 
     summary = connection_command(
@@ -822,13 +796,8 @@ def gait_connection(
     if json_:
         console.print_json(summary)
         return
-    console.out.print(f"wrote {summary['csv']} and {summary['figure']}")
-    if "normalised_rms" in summary:
-        n = summary["normalised_rms"]
-        console.out.print(
-            f"normalised RMS difference from the simulator inside the support: vx {n['vx']:.2f}, "
-            f"vy {n['vy']:.2f}, wz {n['wz']:.2f}, mean {n['mean']:.2f} ({n['n_inside']} shapes)"
-        )
+    for line in connection_lines(summary):
+        console.out.print(line)
 
 
 if __name__ == "__main__":

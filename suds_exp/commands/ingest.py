@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 from suds_exp import console
 from suds_exp.commands.messages import user_message
@@ -39,3 +40,14 @@ def print_ingest(results: list, as_json: bool = False) -> int:
             highlight=False,
         )
     return len(failed)
+
+
+def print_trials(frame, as_json: bool = False) -> None:
+    """The trials of `list_trials` as a table (file names without their folders) or one
+    JSON list."""
+    if as_json:
+        console.print_json(frame)
+    else:
+        shown = frame.drop(columns=["source_file", "ingested_at"])
+        shown.insert(1, "file", frame.source_file.map(lambda p: Path(p).name))
+        console.print_frame(shown, title="trials")
