@@ -398,9 +398,9 @@ def run(
     is refused. Example: suds-exp run paper --prep default --sweep paper --jobs 2
     """
     from suds_exp.campaign import run_campaign
-    from suds_exp.commands.campaign import parse_campaign_options
+    from suds_exp.commands import campaign
 
-    options = parse_campaign_options(
+    options = campaign.parse_campaign_options(
         prep=prep,
         models=models,
         boots=boots,
