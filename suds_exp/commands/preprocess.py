@@ -3,10 +3,11 @@ prints."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from suds_exp import console
-from suds_exp.preprocess import list_versions, parse_param_items
+from suds_exp.errors import ConfigError
+from suds_exp.preprocess import list_versions
 from suds_exp.preprocess import preprocess as run_preprocess
 from suds_exp.robot import parse_ids
 
@@ -65,3 +66,19 @@ def explained_label(params: dict) -> str:
         "kernel-pca": "kernel PCs (feature-space variance)",
         "autoencoder": "autoencoder coordinates (reconstruction)",
     }.get(params.get("reduction", "pca"), "passive PCs")
+
+
+def parse_param_items(items: Iterable[str]) -> dict[str, str]:
+    """``["k=3", "jump_mm=12"]`` -> ``{"k": "3", "jump_mm": "12"}`` (values still text)."""
+    out: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise ConfigError(
+                f"params {item!r}: expected KEY=VALUE, e.g. params k=3", param="params"
+            )
+        if key in out:
+            raise ConfigError(f"params {key}: given twice", param="params")
+        out[key] = value
+    return out
