@@ -163,7 +163,7 @@ def _sizes(d: _Data, at_least: int, mask: np.ndarray | None = None) -> np.ndarra
     if len(sizes) < at_least:
         raise NotMeasurable(
             f"needs same-condition pairs at {at_least}+ training sizes (a sample-efficiency "
-            f"sweep, the campaign's sweep); the campaign has {len(sizes)}"
+            f"sweep); the campaign has {len(sizes)}"
         )
     return sizes
 
@@ -230,7 +230,7 @@ def _few(d: _Data) -> np.ndarray:
     if not mask.any():
         raise NotMeasurable(
             f"no same-condition pairs trained on {FEW_CYCLES} cycles or fewer (a sweep such "
-            "as sweep 1-10)"
+            "as 1-10)"
         )
     return mask
 
