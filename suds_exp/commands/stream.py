@@ -26,13 +26,13 @@ def stream_command(
     """Create or continue stream ``name`` (`run_stream`), then summarise all its rows
     (`summarise`, with the call's ``run`` and, given ``plot``, the figure's path).
     ``trials`` as ids text (``1,2,5-8``); the plot's folder is checked before any row is
-    stored."""
+    stored. ``models`` is a comma list of learner names."""
     if plot is not None:
         check_writable(plot.parent, "plot: folder", param="plot")
     run = run_stream(
         store,
         name,
-        models,
+        [m.strip() for m in models.split(",") if m.strip()],
         parse_ids(trials),
         prep,
         StreamSettings(warmup_cycles=warmup_cycles),
