@@ -496,11 +496,11 @@ def report(
     Example: suds-exp report paper --out reports/paper   (then open reports/paper/index.html)
     """
     from suds_exp.analysis import write_report
+    from suds_exp.commands.report import report_document
 
     index = write_report(open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs)
     if json_:
-        files = sorted(p.name for p in index.parent.iterdir() if p.is_file())
-        console.print_json({"index": str(index), "files": files})
+        console.print_json(report_document(index))
     else:
         console.out.print(f"wrote {index}")
 
