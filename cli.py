@@ -6,15 +6,14 @@ Each command parses options and calls one library function; the work lives in
 
 from __future__ import annotations
 
-import dataclasses
 import functools
-import re
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from suds_exp import __version__, console
+from suds_exp.commands.messages import user_message
 from suds_exp.errors import SudsError
 from suds_exp.store import Store, default_db_path
 
@@ -35,36 +34,6 @@ DbOption = Annotated[
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
-
-
-#: Library parameters whose flag is not simply ``--`` + the name with dashes (in every
-#: command; a command adds its own with ``@command(flags=...)``).
-FLAGS: dict[str, str] = {
-    "effects": "--effect",
-    "params": "--param",
-    "model_params": "--model-param",
-}
-
-
-def flag(param: str, flags: dict[str, str] | None = None) -> str:
-    """The command-line flag of library parameter ``param`` (``max_effects`` ->
-    ``--max-effects``), looked up in ``flags`` and then `FLAGS`."""
-    return {**FLAGS, **(flags or {})}.get(param, "--" + param.replace("_", "-"))
-
-
-def user_message(exc: SudsError, flags: dict[str, str] | None = None) -> str:
-    """The error's one line in the CLI's words: each Python parameter name it is about
-    (the error's ``param``, one name or several) becomes its flag where the text first
-    names it as a word (later uses are ordinary words: "preset papers: unknown preset")."""
-    text, params = str(exc), getattr(exc, "param", None)
-    if not params:
-        return text
-    for param in (params,) if isinstance(params, str) else params:
-        if param.startswith("-"):
-            continue
-        word = rf"(?<![\w.'\"=/\\-]){re.escape(param)}(?![\w'\"/\\-])"
-        text = re.sub(word, flag(param, flags), text, count=1)
-    return text
 
 
 def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None = None, **kwargs):
@@ -173,6 +142,7 @@ def ingest(
     still stored (exit status 2 at the end). Example: suds-exp ingest data/ --manifest
     data/manifest.csv; suds-exp ingest mouse.h5 --fps 30 --mm-per-px 0.1
     """
+    from suds_exp.commands.ingest import print_ingest
     from suds_exp.ingest import PoseOptions, ingest_paths
 
     results = ingest_paths(
@@ -184,49 +154,17 @@ def ingest(
         keep_going=True,
         pose=PoseOptions(software, fps, mm_per_px, confidence_threshold),
     )
-    # a refusal in the command line's words (a parameter named by its flag)
-    results = [
-        dataclasses.replace(r, message=user_message(r.error)) if r.error is not None else r
-        for r in results
-    ]
-    failed = [r for r in results if r.status == "failed"]
-    if json_:
-        console.print_json(
-            [
-                {"file": str(r.path), "status": r.status, "trial_id": r.trial_id}
-                | ({"error": r.message} if r.status == "failed" else {})
-                for r in results
-            ]
-        )
-    else:
-        for r in results:
-            if r.status != "failed":
-                console.out.print(f"{r.status} {r.message}")
-    for r in failed:
-        console.err.print(f"[red]error:[/red] {r.message}", markup=True, highlight=False)
-    if failed and len(results) > 1:
-        console.err.print(
-            f"[red]error:[/red] {len(failed)} of {len(results)} files refused; "
-            "the others are stored",
-            markup=True,
-            highlight=False,
-        )
-    if failed:
+    if print_ingest(results, json_):
         raise typer.Exit(2)
 
 
 @command()
 def trials(db: DbOption = None, json_: JsonOption = False) -> None:
     """List the trials and their conditions."""
+    from suds_exp.commands.ingest import print_trials
     from suds_exp.ingest import list_trials
 
-    frame = list_trials(open_store(db))
-    if json_:
-        console.print_json(frame)
-    else:
-        shown = frame.drop(columns=["source_file", "ingested_at"])
-        shown.insert(1, "file", frame.source_file.map(lambda p: Path(p).name))
-        console.print_frame(shown, title="trials")
+    print_trials(list_trials(open_store(db)), json_)
 
 
 @command()
@@ -289,87 +227,25 @@ def simulate(
     Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on;
     suds-exp simulate --out ell --gait-file ellipse.toml --freqs 1/2 --ingest
     """
-    if gait_file is not None:
-        _simulate_gait_file(
-            gait_file,
-            out,
-            config,
-            gaits,
-            freqs,
-            repeats,
-            cycles,
-            seed,
-            effect,
-            ingest,
-            db,
-            json_,
-            quiet,
-        )
-        return
-    from suds_exp.sim.commands import (
-        build_config,
-        parse_cycles,
-        parse_freqs,
-        parse_gaits,
-        simulate_command,
-    )
-    from suds_exp.sim.schedule import split_effects
+    from suds_exp.commands.simulate import simulate_options, simulate_text
 
-    gait_list, freq_list, cycle_range = parse_gaits(gaits), parse_freqs(freqs), parse_cycles(cycles)
-    static, changes = split_effects(effect or [])
-    sim_config = build_config(config, static)
-    summary = simulate_command(
+    summary = simulate_options(
         out,
-        sim_config,
-        gait_list,
-        freq_list,
+        config,
+        gaits,
+        freqs,
         repeats,
-        cycle_range,
+        cycles,
         seed,
-        changes,
-        store=open_store(db) if ingest else None,
-        progress=not (quiet or json_),
-    )
-    if json_:
-        console.print_json(summary)
-    else:
-        console.out.print(
-            f"wrote {summary['n_trials']} trials ({summary['simulated_seconds']:.0f} s of robot "
-            f"time in {summary['wall_seconds']:.1f} s) and {summary['manifest']}"
-            + (f"; ingested trials {summary['trial_ids']}" if summary["trial_ids"] else "")
-        )
-
-
-def _simulate_gait_file(
-    gait_file, out, config, gaits, freqs, repeats, cycles, seed, effect, ingest, db, json_, quiet
-) -> None:
-    from suds_exp.errors import ConfigError
-    from suds_exp.gait.commands import simulate_file_command
-    from suds_exp.sim.commands import build_config, parse_cycles, parse_freqs
-
-    if gaits:
-        raise ConfigError("use just one of --gaits and --gait-file", param="gaits")
-    if any("@" in e for e in effect or []):
-        raise ConfigError("--gait-file takes effects without a schedule (NAME=VALUE)")
-    summary = simulate_file_command(
-        out,
+        effect or [],
         gait_file,
-        build_config(config, effect or []),
-        frequencies_hz=parse_freqs(freqs),
-        repeats=repeats,
-        cycles=parse_cycles(cycles),
-        seed=seed,
         store=open_store(db) if ingest else None,
         progress=not (quiet or json_),
     )
     if json_:
         console.print_json(summary)
     else:
-        console.out.print(
-            f"wrote {summary['n_trials']} trials of {summary['gait']} "
-            f"({summary['simulated_seconds']:.0f} s of robot time) and {summary['manifest']}"
-            + (f"; ingested trials {summary['trial_ids']}" if summary["trial_ids"] else "")
-        )
+        console.out.print(simulate_text(summary))
 
 
 @command(flags={"half_range": "--range"})
@@ -386,7 +262,7 @@ def connection(
 
     Example: suds-exp connection --out reports/connection.csv --geometry classic
     """
-    from suds_exp.sim.commands import build_config, connection_command
+    from suds_exp.commands.simulate import build_config, connection_command
 
     summary = connection_command(out, grid, range_, geometry, build_config(config, effect or []))
     if json_:
@@ -405,8 +281,8 @@ def effects(
 
     Example: suds-exp effects --json
     """
+    from suds_exp.commands.simulate import build_config, effects_table
     from suds_exp.sim import effect_library
-    from suds_exp.sim.commands import build_config, effects_table
 
     if json_:
         console.print_json(effect_library(build_config(config, effect or [])))
@@ -447,65 +323,47 @@ def preprocess(
     suds-exp preprocess --body snake.toml (a marker chain: shape modes of chord angles)
     suds-exp preprocess --preset paper --name paper (the paper's own processing)
     """
-    from suds_exp.preprocess import list_versions, parse_param_items
-    from suds_exp.preprocess import preprocess as run_preprocess
-    from suds_exp.robot import parse_ids
+    from suds_exp.commands.preprocess import preprocess_command, preprocess_text, print_versions
 
     store = open_store(db)
     if list_:
-        frame = list_versions(store)
-        if json_:
-            console.print_json(frame)
-        else:
-            shown = frame.drop(columns=["params"]).assign(params_hash=frame.params_hash.str[:12])
-            console.print_frame(shown, title="preprocessing versions")
+        print_versions(store, json_)
         return
-    common = dict(
-        params=parse_param_items(param or []),
-        trials=parse_ids(trials_),
-        progress=not (quiet or json_),
-        preset=preset,
+    result = preprocess_command(
+        store, name, param or [], trials_, body, preset, progress=not (quiet or json_)
     )
-    if body is not None:
-        from suds_exp.body import load_body, preprocess_body
-
-        result = preprocess_body(store, load_body(body), name, **common)
-    else:
-        result = run_preprocess(store, name, **common)
     if json_:
         console.print_json(result.to_dict())
-        return
-    ev = ", ".join(f"{100 * r:.1f}%" for r in result.explained_variance_ratio)
-    console.out.print(
-        f"version {result.version_id} ({result.name}, params {result.params_hash[:12]}): "
-        f"{'created' if result.created else 'reused'}; processed {len(result.processed)} "
-        f"trials ({result.n_samples} samples), skipped {len(result.skipped)} already done, "
-        f"in {result.seconds:.1f} s; "
-        f"{_explained_label(result.params)} explain {ev}"
-    )
+    else:
+        console.out.print(preprocess_text(result))
 
 
-def _explained_label(params: dict) -> str:
-    """What a preprocessing result's explained_variance_ratio describes."""
-    if "body" in params:
-        return "shape modes"
-    return {
-        "kernel-pca": "kernel PCs (feature-space variance)",
-        "autoencoder": "autoencoder coordinates (reconstruction)",
-    }.get(params.get("reduction", "pca"), "passive PCs")
+CampaignModelsOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
+        "(+SUDS), sklearn:ClassName[+SUDS]; survey = the five and the baselines."
+    ),
+]
+ModelParamOption = Annotated[
+    list[str] | None,
+    typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
+]
+SkipInfeasibleOption = Annotated[
+    bool | None,
+    typer.Option(
+        "--skip-infeasible/--no-skip-infeasible",
+        help="Leave out the (condition, training size) cells the data cannot supply "
+        "instead of refusing the campaign; stored in its definition.",
+    ),
+]
 
 
 @command()
 def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
     prep: Annotated[str | None, typer.Option(help="Preprocessing version of the samples.")] = None,
-    models: Annotated[
-        str | None,
-        typer.Option(
-            help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
-            "(+SUDS), sklearn:ClassName[+SUDS]; survey = the five and the baselines."
-        ),
-    ] = None,
+    models: CampaignModelsOption = None,
     boots: Annotated[
         int | None, typer.Option(help="Draws per (train, test) pair (default 10).")
     ] = None,
@@ -523,18 +381,8 @@ def run(
     mode: Annotated[
         str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
     ] = None,
-    model_param: Annotated[
-        list[str] | None,
-        typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
-    ] = None,
-    skip_infeasible: Annotated[
-        bool | None,
-        typer.Option(
-            "--skip-infeasible/--no-skip-infeasible",
-            help="Leave out the (condition, training size) cells the data cannot supply "
-            "instead of refusing the campaign; stored in its definition.",
-        ),
-    ] = None,
+    model_param: ModelParamOption = None,
+    skip_infeasible: SkipInfeasibleOption = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
     backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
     scheduler: Annotated[
@@ -549,9 +397,10 @@ def run(
     An option left out of a continued campaign takes its stored value; a different value
     is refused. Example: suds-exp run paper --prep default --sweep paper --jobs 2
     """
-    from suds_exp.campaign import CampaignOptions, run_campaign
+    from suds_exp.campaign import run_campaign
+    from suds_exp.commands import campaign
 
-    options = CampaignOptions.parse(
+    options = campaign.parse_campaign_options(
         prep=prep,
         models=models,
         boots=boots,
@@ -599,21 +448,14 @@ def survey(
 
     Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
     """
-    from suds_exp.analysis.survey import ratio_sentence, survey_json, survey_tables
+    from suds_exp.analysis.survey import survey_json, survey_tables
+    from suds_exp.commands.survey import print_survey
 
     tables = survey_tables(open_store(db), name, cycles, n_boot, versus)
     if json_:
         console.print_json(survey_json(tables))
-        return
-    if "cycles" in tables:
-        console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
-    console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
-    if "glm" in tables:
-        console.print_frame(tables["glm"].round(3), title="GLM, learner as a factor (100 ln)")
-    if "ratio" in tables:
-        console.out.print(ratio_sentence(tables["ratio"], cycles))
-    for why in tables.get("missing", []):
-        console.out.print(f"left out: {user_message(why)}")
+    else:
+        print_survey(tables, cycles)
 
 
 @command()
@@ -624,7 +466,7 @@ def status(
 ) -> None:
     """Jobs done / total per learner, rate and time left of a campaign (also while it runs)."""
     from suds_exp.campaign import campaign_status
-    from suds_exp.campaign.status import print_status
+    from suds_exp.commands.campaign import print_status
 
     report = campaign_status(open_store(db), name)
     if json_:
@@ -654,11 +496,11 @@ def report(
     Example: suds-exp report paper --out reports/paper   (then open reports/paper/index.html)
     """
     from suds_exp.analysis import write_report
+    from suds_exp.commands.report import report_document
 
     index = write_report(open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs)
     if json_:
-        files = sorted(p.name for p in index.parent.iterdir() if p.is_file())
-        console.print_json({"index": str(index), "files": files})
+        console.print_json(report_document(index))
     else:
         console.out.print(f"wrote {index}")
 
@@ -676,24 +518,9 @@ def findings(
 
     Example: suds-exp findings paper --json
     """
-    from suds_exp.analysis.findings import (
-        campaign_passive_information,
-        findings_json,
-        print_findings,
-        print_passive_information,
-    )
-    from suds_exp.analysis.findings import findings as measure
+    from suds_exp.commands.findings import show_findings
 
-    store = open_store(db)
-    table = measure(store, name, n_boot=boot, seed=seed)
-    passive = campaign_passive_information(store, name, n_boot=boot, seed=seed)
-    if json_:
-        doc = findings_json(table, name)
-        doc["passive_information"] = passive.to_dict(orient="records")
-        console.print_json(doc)
-    else:
-        print_findings(table, name)
-        print_passive_information(passive)
+    show_findings(open_store(db), name, n_boot=boot, seed=seed, as_json=json_)
 
 
 @command(flags={"exclude": "--exclude-candidates", "model_effects": "--model-effect"})
@@ -741,49 +568,23 @@ def discrepancy(
 
     Example: suds-exp discrepancy --model-effect flippers=absent --max-effects 2
     """
-    from suds_exp.discrepancy import DiscrepancyOptions, run_discrepancy
-    from suds_exp.discrepancy.discover import DiscoverySettings
-    from suds_exp.discrepancy.workflow import default_name, parse_exclude
-    from suds_exp.robot import parse_ids
-    from suds_exp.sim.commands import build_config
-
-    start = build_config(model, model_effect or [], param="model_effects")
-    # options are checked before the database is opened
-    options = DiscrepancyOptions(
-        alpha=alpha,
-        max_effects=max_effects,
-        seed=seed,
-        exclude=parse_exclude(exclude_candidates),
-        discover=discover,
-        discovery=DiscoverySettings(max_terms=max_terms),
+    from suds_exp.commands.discrepancy import (
+        discrepancy_command,
+        discrepancy_options,
+        print_discrepancy,
+        start_model,
     )
-    name = name or default_name()
-    if out is None:
-        out = Path("reports") / (name if name.startswith("discrepancy") else f"discrepancy-{name}")
-    result = run_discrepancy(
-        open_store(db),
-        prep,
-        start,
-        name=name,
-        trials=parse_ids(trials),
-        options=options,
-        out=out,
-        progress=not (quiet or json_),
+
+    start = start_model(model, model_effect or [])
+    # options are checked before the database is opened
+    options = discrepancy_options(alpha, max_effects, seed, exclude_candidates, discover, max_terms)
+    result = discrepancy_command(
+        open_store(db), start, options, trials, prep, name, out, progress=not (quiet or json_)
     )
     if json_:
         console.print_json(result.to_json())
-        return
-    for n in result.named:
-        console.out.print(
-            f"step {n['step']}: {n['candidate']} {n['parameter'] or ''} = {n['value']} "
-            f"{n['unit']} {n['ci']} (p_adj {n['p_adjusted']:.2g}); "
-            f"held-out loss {n['gap_before']:.4g} -> {n['gap_after']:.4g}"
-        )
-    if result.discovery is not None:
-        for line in result.discovery.equations():
-            console.out.print(f"learned correction: {line}")
-    console.out.print(result.outcome)
-    console.out.print(f"report: {result.report_dir}")
+    else:
+        print_discrepancy(result)
 
 
 @command()
@@ -846,41 +647,23 @@ def stream(
     --effect medium_compaction=on@20s --ingest && suds-exp preprocess && suds-exp stream
     bed --models GMR,OnlineGMR --plot reports/bed.png
     """
-    from suds_exp.robot import parse_ids
-    from suds_exp.store.files import check_writable
-    from suds_exp.stream import StreamSettings, plot_error, run_stream, stream_rows, summarise
+    from suds_exp.commands.stream import print_stream, stream_command
 
-    store = open_store(db)
-    if plot is not None:  # before any row is stored
-        check_writable(plot.parent, "plot: folder", param="plot")
-    run = run_stream(
-        store,
+    summary = stream_command(
+        open_store(db),
         name,
         models,
-        parse_ids(trials_),
+        trials_,
         prep,
-        StreamSettings(warmup_cycles=warmup),
+        warmup,
         change_at,
+        plot,
         progress=not (quiet or json_),
     )
-    rows = stream_rows(store, name)
-    summary = summarise(rows)
-    summary["run"] = run.to_dict()
-    if plot is not None:
-        summary["plot"] = str(plot_error(rows, plot))
     if json_:
         console.print_json(summary)
-        return
-    import pandas as pd
-
-    table = pd.DataFrame(summary["models"]).map(
-        lambda v: "-" if pd.isna(v) else (f"{v:.3g}" if isinstance(v, float) else v)
-    )
-    console.print_frame(
-        table.reset_index(names="per learner"), title=f"stream {name}: {run.done_now} new runs"
-    )
-    if plot is not None:
-        console.out.print(f"wrote {summary['plot']}")
+    else:
+        print_stream(summary)
 
 
 gait_app = typer.Typer(
@@ -913,9 +696,9 @@ def gait_predict(
 
     Example: suds-exp gait predict --gait-file ellipse.toml --freq 1/2 --learner GMR --json
     """
-    from suds_exp.gait.commands import predict_command
+    from suds_exp.commands.gait import predict_command, predict_text
+    from suds_exp.commands.simulate import parse_freqs
     from suds_exp.robot import parse_ids
-    from suds_exp.sim.commands import parse_freqs
 
     (frequency,) = parse_freqs(freq)[:1]
     doc = predict_command(
@@ -923,15 +706,8 @@ def gait_predict(
     )
     if json_:
         console.print_json(doc)
-        return
-    ci = doc["interval"].get("forward_mm")
-    console.out.print(
-        f"{doc['gait']} at {doc['frequency_hz']:g} Hz ({learner}): forward "
-        f"{doc['forward_mm']:.1f} mm/cycle"
-        + (f" [{ci[0]:.1f}, {ci[1]:.1f}]" if ci else "")
-        + f", lateral {doc['lateral_mm']:.1f} mm, turn {doc['turn_rad']:.3f} rad, "
-        f"mean vx {doc['mean_vx_mm_s']:.1f} mm/s"
-    )
+    else:
+        console.out.print(predict_text(doc, learner))
 
 
 @command(on=gait_app, name="design", flags={"frequency_hz": "--freq"})
@@ -958,9 +734,9 @@ def gait_design(
     Every iteration is stored (table gait_design_iterations).
     Example: suds-exp gait design --bound 1.3 --iterations 5 --verify --json
     """
-    from suds_exp.gait.commands import design_command
+    from suds_exp.commands.gait import design_command, iteration_text
+    from suds_exp.commands.simulate import build_config, parse_freqs
     from suds_exp.gait.design import DesignOptions
-    from suds_exp.sim.commands import build_config, parse_freqs
 
     options = DesignOptions(
         learner=learner,
@@ -971,14 +747,7 @@ def gait_design(
         order=order,
     )
 
-    def say(it) -> None:
-        if not json_:
-            ach = f", achieved {it.achieved.forward_mm:.1f}" if it.achieved else ""
-            console.out.print(
-                f"iteration {it.iteration}: predicted {it.predicted.forward_mm:.1f} mm/cycle"
-                f"{ach}; trust radius {it.trust_radius:.3f} ({it.seconds:.0f} s)"
-            )
-
+    say = None if json_ else (lambda it: console.out.print(iteration_text(it)))
     doc = design_command(
         open_store(db), prep, options, out, build_config(config, []) if config else None, say
     )
@@ -1010,8 +779,8 @@ def gait_connection(
 
     Example: suds-exp gait connection --out reports/learned.csv --compare
     """
-    from suds_exp.gait.commands import connection_command
-    from suds_exp.sim.commands import build_config
+    from suds_exp.commands.gait import connection_command, connection_lines
+    from suds_exp.commands.simulate import build_config
 
     summary = connection_command(
         open_store(db),
@@ -1027,13 +796,8 @@ def gait_connection(
     if json_:
         console.print_json(summary)
         return
-    console.out.print(f"wrote {summary['csv']} and {summary['figure']}")
-    if "normalised_rms" in summary:
-        n = summary["normalised_rms"]
-        console.out.print(
-            f"normalised RMS difference from the simulator inside the support: vx {n['vx']:.2f}, "
-            f"vy {n['vy']:.2f}, wz {n['wz']:.2f}, mean {n['mean']:.2f} ({n['n_inside']} shapes)"
-        )
+    for line in connection_lines(summary):
+        console.out.print(line)
 
 
 if __name__ == "__main__":

@@ -43,7 +43,8 @@ from suds_exp.analysis.findings import (  # noqa: E402
     findings_summary,
 )
 from suds_exp.analysis.formatting import to_markdown  # noqa: E402
-from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
+from suds_exp.campaign import run_campaign  # noqa: E402
+from suds_exp.commands.campaign import parse_campaign_options  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 
@@ -106,7 +107,7 @@ def main() -> None:
             t0 = time.perf_counter()
             prep = prepare(db, seed, args.set, args.config)
             t1 = time.perf_counter()
-            options = CampaignOptions.parse(
+            options = parse_campaign_options(
                 prep=prep, boots=args.boots, sweep=args.sweep, train_cycles=30
             )
             options.skip_infeasible = args.skip_infeasible or None

@@ -43,9 +43,9 @@ from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from suds_exp.commands.simulate import simulate_command  # noqa: E402
 from suds_exp.preprocess import Phaser, load_samples, preprocess  # noqa: E402
 from suds_exp.preprocess.truth import truth_path  # noqa: E402
-from suds_exp.sim.commands import simulate_command  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 ORDER = 10

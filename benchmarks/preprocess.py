@@ -36,9 +36,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from suds_exp.body import load_body, preprocess_body  # noqa: E402
+from suds_exp.commands.simulate import simulate_command  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
 from suds_exp.preprocess.truth import truth_errors  # noqa: E402
-from suds_exp.sim.commands import simulate_command  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
 

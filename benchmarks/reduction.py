@@ -33,7 +33,8 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from suds_exp.analysis.queries import load_results  # noqa: E402
-from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
+from suds_exp.campaign import run_campaign  # noqa: E402
+from suds_exp.commands.campaign import parse_campaign_options  # noqa: E402
 from suds_exp.preprocess import preprocess  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
@@ -73,7 +74,7 @@ def main() -> None:
         for r, version in versions.items():
             copy = Path(tmp) / f"{r}.duckdb"
             shutil.copyfile(args.db, copy)
-            options = CampaignOptions.parse(
+            options = parse_campaign_options(
                 prep=version,
                 models=args.models,
                 boots=args.boots,

@@ -53,7 +53,8 @@ from suds_exp.analysis.survey import (  # noqa: E402
     ratio_sentence,
     survey_from_results,
 )
-from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
+from suds_exp.campaign import run_campaign  # noqa: E402
+from suds_exp.commands.campaign import parse_campaign_options  # noqa: E402
 from suds_exp.models.registry import LEARNERS  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
 
@@ -125,7 +126,7 @@ def main() -> None:
     else:
         conditions, names = [args.conditions], [args.campaign]
     for name, cond in zip(names, conditions, strict=True):
-        options = CampaignOptions.parse(
+        options = parse_campaign_options(
             prep=args.prep,
             models=args.models,
             sweep=args.sweep,

@@ -11,12 +11,21 @@ class SudsError(Exception):
 
     ``param`` names the Python parameter(s) the error is about (one name or a tuple), as
     the message writes them; the CLI shows each one's flag instead (``trials`` ->
-    ``--trials``).
+    ``--trials``). ``step`` names the library step that would help (``"ingest"``,
+    ``"preprocess"``, ``"init"``, ``"run"``, ``"stream"``, ``"trials"``), which the
+    message advises in words; the CLI adds the command that takes it.
     """
 
-    def __init__(self, message: str = "", *, param: str | tuple[str, ...] | None = None):
+    def __init__(
+        self,
+        message: str = "",
+        *,
+        param: str | tuple[str, ...] | None = None,
+        step: str | tuple[str, ...] | None = None,
+    ):
         super().__init__(message)
         self.param = param
+        self.step = step
 
 
 class IngestError(SudsError):

@@ -114,7 +114,7 @@ def test_status_and_sql_answer_and_a_second_run_is_refused_while_a_campaign_runs
         assert out.exit_code == 0, out.output
         assert json.loads(out.stdout)[0]["n"] >= status["done"]
         out = runner.invoke(cli.app, ["run", "c", "--db", str(db)])
-        assert out.exit_code == 2 and "`suds-exp run` 'c'" in out.output
+        assert out.exit_code == 2 and ": run 'c' (pid" in out.output
         assert child.poll() is None
     finally:
         child.send_signal(signal.SIGINT)

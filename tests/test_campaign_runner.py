@@ -109,7 +109,7 @@ def test_a_second_run_on_the_same_database_is_refused(db, samples):
     store = Store(db)
     with (
         RunLock(db, "other"),
-        pytest.raises(StoreError, match="`suds-exp run` 'other' .* is writing to this database"),
+        pytest.raises(StoreError, match=": run 'other' .* is writing to this database"),
     ):
         run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from suds_exp.campaign.definition import CampaignOptions
+from suds_exp.commands.campaign import parse_campaign_options
 from suds_exp.models import BASELINE_NAMES, MODEL_NAMES, ONLINE_MODELS, make_model
 from suds_exp.models.registry import (
     LEARNERS,
@@ -23,7 +23,7 @@ def test_the_paper_five_in_its_order():
 
 def test_survey_is_the_five_and_the_baselines_it_names():
     assert SURVEY_LEARNERS == (*LEARNERS, "MLP", "MLP+SUDS", "GBT", "kNN", "KRR")
-    assert list(CampaignOptions.parse(models="survey").models) == list(SURVEY_LEARNERS)
+    assert list(parse_campaign_options(models="survey").models) == list(SURVEY_LEARNERS)
 
 
 def test_baselines_and_online_learners_match_their_builders():

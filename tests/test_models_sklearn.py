@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 import cli
 from suds_exp.campaign import CampaignOptions, run_campaign
+from suds_exp.commands.campaign import parse_campaign_options
 from suds_exp.errors import ConfigError
 from suds_exp.models import make_model, model_recipe
 from suds_exp.store import Store
@@ -212,7 +213,7 @@ def survey_db(tmp_path_factory, samples_file):
     """A campaign with a sweep on the preprocessed-samples path the CLI uses."""
     db = tmp_path_factory.mktemp("survey") / "s.duckdb"
     samples = pd.read_parquet(samples_file)
-    opts = CampaignOptions.parse(
+    opts = parse_campaign_options(
         models=f"GMR,MLP,{CUSTOM}",
         sweep="1,2,3",
         model_params=[
@@ -267,7 +268,7 @@ def test_survey_command_prints_cycles_to_target_and_the_ratio(survey_db):
 def test_survey_of_a_main_grid_without_sweep_gives_the_glm_and_timing(tmp_path, samples_file):
     # the paper's grid alone (cross pairs, one size) answers the generalisation question
     db = tmp_path / "grid.duckdb"
-    opts = CampaignOptions.parse(
+    opts = parse_campaign_options(
         models="GMR,kNN",
         boots=2,
         train_cycles=2,
@@ -294,7 +295,7 @@ def test_survey_of_a_campaign_with_neither_sweep_nor_cross_pairs_is_one_line(
     tmp_path, samples_file
 ):
     db = tmp_path / "one.duckdb"
-    opts = CampaignOptions.parse(
+    opts = parse_campaign_options(
         models="GMR", boots=1, train_cycles=2, train_conditions="O@0.5", test_conditions="O@0.5"
     )
     run_campaign(Store(db), "one", opts, samples=pd.read_parquet(samples_file), progress=False)

@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from suds_exp.commands.simulate import simulate_command
 from suds_exp.preprocess import preprocess
 from suds_exp.preprocess.truth import truth_errors
-from suds_exp.sim.commands import simulate_command
 from suds_exp.store import Store
 
 

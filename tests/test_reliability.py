@@ -121,7 +121,7 @@ def test_a_second_writer_is_refused_in_one_line_naming_the_holder(data, tmp_path
     try:
         assert holder.stdout.readline().strip() == "held"
         monkeypatch.setattr(write_lock, "WRITE_WAIT_S", 0.3)
-        named = f"`suds-exp preprocess` 'v9' (pid {holder.pid} on "
+        named = f"preprocess 'v9' (pid {holder.pid} on "
         for args in (
             ["init"],
             ["ingest", str(data.captures), "--manifest", str(data.manifest)],
@@ -131,7 +131,7 @@ def test_a_second_writer_is_refused_in_one_line_naming_the_holder(data, tmp_path
             ["discrepancy", "--name", "d", "--out", str(tmp_path / "d")],
         ):
             line = one_line_refusal(args, db, named)
-            assert "another `suds-exp run`" not in line and "campaign" not in line
+            assert "another run" not in line and "campaign" not in line
     finally:
         holder.kill()
         holder.wait()

@@ -163,3 +163,39 @@ def test_campaign_and_discrepancy_name_the_version_they_lack(two_versions, tmp_p
         assert res.exit_code == 2, res.output
         want = "error: --trials '2-x': expected ids and ranges such as 1,2,5-8"
         assert res.stderr.strip() == want
+
+
+def test_a_campaign_resolves_its_version_once_and_rewrites_no_option(
+    two_versions, tmp_path, monkeypatch
+):
+    """`run_campaign` turns ``prep`` into a `Version` once, at the top, and passes its name
+    and samples down: the version is looked up once and the caller's options stay as given."""
+    import dataclasses
+
+    from suds_exp.campaign import CampaignOptions, run_campaign
+    from suds_exp.preprocess import version as version_module
+
+    db = tmp_path / "db.duckdb"
+    shutil.copyfile(two_versions, db)
+    looked_up = []
+    find = version_module.find_version_row
+    monkeypatch.setattr(
+        version_module,
+        "find_version_row",
+        lambda conn, ref: looked_up.append(ref) or find(conn, ref),
+    )
+    options = CampaignOptions(
+        prep="wide",
+        models=["phase-only"],
+        boots=1,
+        train_cycles=2,
+        train_conditions="O@0.5",
+        test_conditions="D+@0.5",
+    )
+    given = dataclasses.replace(options)
+    summary = run_campaign(Store(db), "c", options, progress=False)
+    assert summary.done_now == summary.total_jobs > 0
+    assert looked_up == ["wide"]
+    assert options == given
+    stored = Store(db).query_df("SELECT prep_version FROM campaigns WHERE name = 'c'")
+    assert stored.prep_version.tolist() == ["wide"]

@@ -163,7 +163,7 @@ def _sizes(d: _Data, at_least: int, mask: np.ndarray | None = None) -> np.ndarra
     if len(sizes) < at_least:
         raise NotMeasurable(
             f"needs same-condition pairs at {at_least}+ training sizes (a sample-efficiency "
-            f"sweep, `--sweep`); the campaign has {len(sizes)}"
+            f"sweep); the campaign has {len(sizes)}"
         )
     return sizes
 
@@ -230,7 +230,7 @@ def _few(d: _Data) -> np.ndarray:
     if not mask.any():
         raise NotMeasurable(
             f"no same-condition pairs trained on {FEW_CYCLES} cycles or fewer (a sweep such "
-            "as `--sweep 1-10`)"
+            "as 1-10)"
         )
     return mask
 
@@ -689,14 +689,6 @@ def findings_json(table: pd.DataFrame, campaign: str) -> dict:
     }
 
 
-def print_findings(table: pd.DataFrame, campaign: str) -> None:
-    """Print the findings table and its headline on the terminal."""
-    from suds_exp import console
-
-    console.print_frame(findings_display(table), title=f"the paper's findings on {campaign}")
-    console.out.print(findings_headline(table))
-
-
 # -- what the passive shape adds ----------------------------------------------------------
 #: What `passive_information` means, printed beside it by the demo and the report.
 PASSIVE_EXPLANATION = (
@@ -867,14 +859,3 @@ def passive_display(table: pd.DataFrame) -> pd.DataFrame:
             ],
         }
     )
-
-
-def print_passive_information(table: pd.DataFrame) -> None:
-    """Print the passive-information table and its explanation on the terminal."""
-    from suds_exp import console
-
-    if table.empty:
-        console.out.print("what the passive shape adds: not measurable (no stored samples)")
-        return
-    console.print_frame(passive_display(table), title="what the passive shape adds")
-    console.out.print(PASSIVE_EXPLANATION)

@@ -64,7 +64,8 @@ def load_results(store: Store, campaign: str, columns=ANALYSIS_COLUMNS) -> pd.Da
         known = campaigns(store)["campaign"].tolist()
         raise AnalysisError(
             f"campaign {campaign!r} has no results with a finite rmse_vx; campaigns with "
-            f"results: {', '.join(known) if known else 'none (run `suds-exp run` first)'}"
+            f"results: {', '.join(known) if known else 'none (run a campaign first)'}",
+            step=None if known else "run",
         )
     for col in ("gait_sim", "period_rel", "freq_sim"):
         if col in frame:

@@ -166,7 +166,7 @@ def _chain_meta(conn: sa.Connection, trial_ids) -> pd.DataFrame:
             )
         meta = meta[meta.id.isin(wanted)]
     if meta.empty:
-        raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+        raise PreprocessError("no trials to preprocess; ingest some first", step="ingest")
     return meta
 
 

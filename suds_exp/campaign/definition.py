@@ -19,12 +19,11 @@ from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import (
     Condition,
     format_condition,
-    parse_int_list,
     select_conditions,
 )
 from suds_exp.campaign.sampling import infeasible_cells
 from suds_exp.errors import CampaignError, ConfigError
-from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
+from suds_exp.models.registry import LEARNERS
 
 MODES = ("measured", "rollout")
 DEFINITION_VERSION = 1
@@ -66,64 +65,6 @@ class CampaignOptions:
     test_conditions: str | list[Condition] | None = None
     mode: str | None = None
     skip_infeasible: bool | None = None
-
-    @classmethod
-    def parse(
-        cls,
-        *,
-        models: str | None = None,
-        sweep: str | None = None,
-        model_params: Sequence[str] | None = None,
-        **rest,
-    ):
-        """Options from command-line strings: ``models="TLS,GMR"`` (``survey`` stands for
-        `SURVEY_LEARNERS`), ``sweep="1-10,21"`` (or ``"paper"``), ``model_params`` as
-        ``["MLP.alpha=0.01", ...]`` (see `parse_model_params`); the rest as in the class."""
-        names = None if models is None else [m.strip() for m in models.split(",") if m.strip()]
-        if names is not None:
-            names = [n for m in names for n in (SURVEY_LEARNERS if m == "survey" else (m,))]
-        cycles = None if sweep is None else parse_int_list(sweep, "sweep")
-        chosen = names
-        if model_params:
-            chosen = parse_model_params(model_params, names or list(LEARNERS))
-        if chosen is not None:
-            # a bad learner spec fails here, before the database is opened
-            resolve_models(chosen, rest.get("mode") or DEFAULTS.mode)
-        return cls(models=chosen, sweep=cycles, **rest)
-
-
-def parse_model_params(items: Sequence[str], names: Sequence[str]) -> dict[str, dict]:
-    """``NAME.KEY=VALUE`` strings -> {name: {key: value}} over every name in ``names``.
-
-    NAME may itself hold dots (``sklearn:pkg.mod.Class``): KEY is what follows the last
-    dot before ``=``. VALUE is read as JSON (``true``, ``0.01``, ``[64, 64]``), else as a
-    Python literal (``(64, 64)``), else kept as text.
-    """
-    import ast
-
-    out: dict[str, dict] = {n: {} for n in names}
-    for item in items:
-        left, eq, text = item.partition("=")
-        name, dot, key = left.strip().rpartition(".")
-        if not eq or not dot or not name or not key:
-            raise CampaignError(
-                f"model_params {item!r}: expected NAME.KEY=VALUE, e.g. MLP.alpha=0.01",
-                param="model_params",
-            )
-        if name not in out:
-            raise CampaignError(
-                f"model_params {item!r}: learner {name!r} is not in models ({', '.join(names)})",
-                param=("model_params", "models"),
-            )
-        try:
-            value = json.loads(text)
-        except ValueError:
-            try:
-                value = ast.literal_eval(text)
-            except (ValueError, SyntaxError):
-                value = text
-        out[name][key.strip()] = value
-    return out
 
 
 DEFAULTS = CampaignOptions(

@@ -16,6 +16,7 @@ write-ahead log makes each batch all-or-nothing.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import logging
 import math
@@ -239,7 +240,9 @@ def run_campaign(
     with RunLock(store.path, name):
         store.upgrade()
         stored = load_stored_definition(store, name)
-        plan, bank = plan_campaign(store, name, merge_stored(options, stored), stored, samples)
+        merged = merge_stored(options, stored)
+        prep, samples = campaign_samples(store, merged.prep, samples)
+        plan, bank = plan_campaign(name, dataclasses.replace(merged, prep=prep), stored, samples)
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
             plan, finished_keys(store, name), chunk_jobs or _default_chunk(plan, n_workers)
@@ -299,19 +302,27 @@ def check_scheduler(address: str, wait_s: float = SCHEDULER_WAIT_S) -> None:
         ) from None
 
 
+def campaign_samples(
+    store: Store, prep: str | int | None, samples: pd.DataFrame | None = None
+) -> tuple[str | int, pd.DataFrame]:
+    """The label and samples frame a campaign runs on: preprocessing version ``prep``
+    (resolved once, here, into its `Version`: its name and samples) or, given ``samples``,
+    that frame, labelled ``prep`` (default ``"(samples given)"``)."""
+    if samples is not None:
+        return (prep if prep is not None else "(samples given)"), samples
+    from suds_exp.preprocess import get_version
+
+    version = get_version(store, prep)
+    return version.name, version.samples()
+
+
 def plan_campaign(
-    store: Store, name: str, options: CampaignOptions, stored: dict | None, samples=None
+    name: str, options: CampaignOptions, stored: dict | None, samples: pd.DataFrame
 ) -> tuple[Plan, SampleBank]:
     """The plan and sample bank of campaign ``name`` with ``options`` (merged with the
-    ``stored`` definition): loads the version's samples unless ``samples`` is given, and
-    refuses a definition that differs from the stored one or data that cannot supply it."""
-    if samples is None:
-        from suds_exp.preprocess import get_version
-
-        version = get_version(store, options.prep)
-        options.prep, samples = version.name, version.samples()
-    elif options.prep is None:
-        options.prep = "(samples given)"
+    ``stored`` definition; ``options.prep`` the label of ``samples``, see
+    `campaign_samples`); refuses a definition that differs from the stored one or data that
+    cannot supply it."""
     plan, bank = make_plan(
         name, options, rounded_conditions(samples), lambda c: SampleBank.build(samples, c)
     )

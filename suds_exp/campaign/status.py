@@ -7,7 +7,6 @@ from datetime import UTC, datetime
 
 import pandas as pd
 
-from suds_exp.campaign.definition import skipped_cells_text
 from suds_exp.campaign.lock import run_holder
 from suds_exp.errors import CampaignError
 from suds_exp.store import Store
@@ -33,8 +32,8 @@ def _read_status(raw, path, name: str):
             else []
         )
         raise CampaignError(
-            f"no campaign {name!r} in {path} (have: {', '.join(names) or 'none'}); "
-            "start one with `suds-exp run NAME`"
+            f"no campaign {name!r} in {path} (have: {', '.join(names) or 'none'}); start one first",
+            step="run",
         )
     definition, total, prep = json.loads(row[0]), int(row[1]), row[2]
     per_model = raw.execute(
@@ -113,36 +112,3 @@ def campaign_status(store: Store, name: str) -> dict:
         "eta_s": eta,
         "skipped_cells": definition.get("skipped_cells", []),
     }
-
-
-def print_status(status: dict) -> None:
-    """Print `campaign_status` as a per-learner table and one summary line."""
-    from suds_exp import console
-
-    frame = pd.DataFrame(status["models"])
-    console.print_frame(frame, title=f"campaign {status['campaign']} (prep {status['prep']})")
-    rate = status["rate_jobs_per_s"]
-    line = f"{status['done']} / {status['total']} jobs done"
-    if status["failed"]:
-        line += f", {status['failed']} failed (see results.error)"
-    if status["running"]:
-        line += " - running"
-        if rate:
-            line += f" at {rate:.2f} jobs/s, about {_duration(status['eta_s'])} left"
-    elif rate:
-        line += f" - not running (last run: {rate:.2f} jobs/s)"
-    console.out.print(line)
-    if status.get("skipped_cells"):
-        console.out.print(
-            "left out (--skip-infeasible; the data cannot supply them): "
-            + skipped_cells_text(status)
-        )
-
-
-def _duration(seconds: float | None) -> str:
-    if seconds is None:
-        return "?"
-    seconds = int(round(seconds))
-    h, rem = divmod(seconds, 3600)
-    m, s = divmod(rem, 60)
-    return f"{h}h{m:02d}m" if h else (f"{m}m{s:02d}s" if m else f"{s}s")

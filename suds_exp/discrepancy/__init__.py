@@ -9,7 +9,7 @@ from suds_exp.discrepancy.replay import ReplaySettings
 from suds_exp.discrepancy.workflow import (
     DiscrepancyOptions,
     DiscrepancyResult,
-    parse_exclude,
+    check_exclude,
     run_discrepancy,
 )
 from suds_exp.errors import DiscrepancyError
@@ -24,7 +24,7 @@ __all__ = [
     "FitSettings",
     "ReplaySettings",
     "candidates_for",
+    "check_exclude",
     "parse_effect_items",
-    "parse_exclude",
     "run_discrepancy",
 ]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -97,7 +97,7 @@ class DiscrepancyOptions:
     discovery: DiscoverySettings = field(default_factory=DiscoverySettings)
 
     def __post_init__(self) -> None:
-        self.exclude = parse_exclude(",".join(self.exclude))
+        self.exclude = check_exclude(self.exclude)
         if not self.discover and set(effect_names()) <= set(self.exclude):
             raise DiscrepancyError(
                 "exclude: every candidate is excluded and discovery is off; "
@@ -281,16 +281,16 @@ def discovery_json(d: Discovery | None) -> dict | None:
     }
 
 
-def parse_exclude(text: str | None) -> tuple[str, ...]:
-    """``"body_inertia,hinge_damping"`` -> a tuple of effect names, each checked."""
-    if text is None or not text.strip():
-        return ()
-    names = effect_names()
-    out = tuple(x.strip() for x in text.split(",") if x.strip())
+def check_exclude(names: Sequence[str]) -> tuple[str, ...]:
+    """``names`` of effects never offered as candidates, each checked, as a tuple."""
+    known = effect_names()
+    if isinstance(names, str):
+        names = (names,)
+    out = tuple(str(x).strip() for x in names if str(x).strip())
     for x in out:
-        if x not in names:
+        if x not in known:
             raise DiscrepancyError(
-                f"exclude {x!r}: unknown effect; expected one of {', '.join(names)}",
+                f"exclude {x!r}: unknown effect; expected one of {', '.join(known)}",
                 param="exclude",
             )
     return out

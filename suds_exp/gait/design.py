@@ -228,7 +228,9 @@ def design_gait(
     version = get_version(store, prep)
     samples = version.samples()
     if samples.empty:
-        raise ConfigError(f"version {version.name} has no samples; run `suds-exp preprocess`")
+        raise ConfigError(
+            f"version {version.name} has no samples; preprocess trials first", step="preprocess"
+        )
     design_id = _register(store, version.id, opts)
     design = Design(design_id, version.id, opts)
     out = Path(out)

@@ -67,7 +67,7 @@ def simulate_gait_file(
     progress: bool = False,
 ) -> dict:
     """Simulate trials of ``gait`` into ``out`` and (given a `Store`) ingest them; a
-    JSON-ready summary like `suds_exp.sim.commands.simulate_command`'s."""
+    JSON-ready summary like `suds_exp.commands.simulate.simulate_command`'s."""
     start = time.perf_counter()
     specs = gait_trial_specs(gait, frequencies_hz, repeats, cycles, seed)
     ds = simulate_dataset(out, config or SimConfig(), specs=specs, progress=progress)

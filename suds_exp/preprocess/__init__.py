@@ -5,7 +5,6 @@ from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.params import (
     DEFAULTS,
     PRESETS,
-    parse_param_items,
     preset_params,
     resolve_params,
 )
@@ -26,7 +25,6 @@ __all__ = [
     "get_version",
     "list_versions",
     "load_samples",
-    "parse_param_items",
     "preprocess",
     "preset_params",
     "resolve_params",

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 from suds_exp.errors import ConfigError
@@ -178,22 +178,6 @@ def resolve_params(
         params[key] = _coerce(key, value)
     _check(params)
     return params
-
-
-def parse_param_items(items: Iterable[str]) -> dict[str, str]:
-    """``["k=3", "jump_mm=12"]`` -> ``{"k": "3", "jump_mm": "12"}`` (values still text)."""
-    out: dict[str, str] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        key, value = key.strip(), value.strip()
-        if not sep or not key or not value:
-            raise ConfigError(
-                f"params {item!r}: expected KEY=VALUE, e.g. params k=3", param="params"
-            )
-        if key in out:
-            raise ConfigError(f"params {key}: given twice", param="params")
-        out[key] = value
-    return out
 
 
 def params_json(params: Mapping[str, Any]) -> str:

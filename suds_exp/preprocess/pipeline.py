@@ -162,8 +162,9 @@ def _trial_meta(conn: sa.Connection, trial_ids: Iterable[int] | None) -> pd.Data
         unknown = sorted(set(wanted) - set(int(i) for i in meta.id))
         if unknown:
             raise PreprocessError(
-                f"trials: no trial with id {', '.join(map(str, unknown))}; see `suds-exp trials`",
+                f"trials: no trial with id {', '.join(map(str, unknown))}; see the stored trials",
                 param="trials",
+                step="trials",
             )
         meta = meta[meta.id.isin(wanted)]
     return meta.reset_index(drop=True)
@@ -340,7 +341,7 @@ def _preprocess(store, name, params, trials, progress, started, model) -> PrepRe
         todo = meta[~meta.id.isin(done)]
         tracks = _read_tracks(conn, todo, model) if len(todo) else {}
     if meta.empty:
-        raise PreprocessError("no trials to preprocess; ingest some with `suds-exp ingest`")
+        raise PreprocessError("no trials to preprocess; ingest some first", step="ingest")
     result = new_result(row, name, params, digest, skipped=meta.id[meta.id.isin(done)])
     items = clean(todo, tracks, params, progress, model)
     if not items:

@@ -62,8 +62,9 @@ class Version:
 
     def samples(self, trials: Iterable[int] | None = None) -> pd.DataFrame:
         """The version's samples (`suds_exp.preprocess.load_samples`), optionally of
-        ``trials`` (ids) only."""
-        return load_samples(self.store, self.id, trials)
+        ``trials`` (ids) only; read by the version's id, not looked up again."""
+        with self.store.read() as conn:
+            return _read_samples(conn, self.id, self.k, self.params, trials)
 
 
 def find_version_row(conn: sa.Connection, version: int | str) -> sa.Row:
@@ -94,8 +95,9 @@ def require_tables(conn: sa.Connection) -> None:
     ).scalar_one()
     if not found:
         raise PreprocessError(
-            "this database has no preprocessing tables yet; run `suds-exp preprocess` "
-            "(or `suds-exp init` to upgrade it)"
+            "this database has no preprocessing tables yet; preprocess trials (or upgrade "
+            "the database) first",
+            step=("preprocess", "init"),
         )
 
 
@@ -121,20 +123,28 @@ def load_samples(
     with store.read() as conn:
         require_tables(conn)
         row = find_version_row(conn, version)
-        cols = sample_columns(row.k, actuated_dimension(json.loads(row.params)))
-        select = ", ".join(f's."{c}"' for c in cols)
-        where = "s.version_id = ?"
-        args: list[Any] = [row.id]
-        if trials is not None:
-            ids = sorted({int(i) for i in trials})
-            where += f" AND s.trial_id IN ({', '.join('?' * len(ids))})" if ids else " AND false"
-            args += ids
-        return Store.frame(
-            conn,
-            f"SELECT {select}, t.gait, t.frequency_hz FROM samples s "
-            f"JOIN trials t ON t.id = s.trial_id WHERE {where} ORDER BY s.trial_id, s.frame",
-            args,
-        )
+        return _read_samples(conn, row.id, row.k, json.loads(row.params), trials)
+
+
+def _read_samples(
+    conn: sa.Connection, version_id: int, k: int, params: dict, trials: Iterable[int] | None
+) -> pd.DataFrame:
+    """The samples of version ``version_id`` (``k`` passive PCs, parameters ``params``);
+    see `load_samples`."""
+    cols = sample_columns(k, actuated_dimension(params))
+    select = ", ".join(f's."{c}"' for c in cols)
+    where = "s.version_id = ?"
+    args: list[Any] = [int(version_id)]
+    if trials is not None:
+        ids = sorted({int(i) for i in trials})
+        where += f" AND s.trial_id IN ({', '.join('?' * len(ids))})" if ids else " AND false"
+        args += ids
+    return Store.frame(
+        conn,
+        f"SELECT {select}, t.gait, t.frequency_hz FROM samples s "
+        f"JOIN trials t ON t.id = s.trial_id WHERE {where} ORDER BY s.trial_id, s.frame",
+        args,
+    )
 
 
 def get_version(store: Store, ref: int | str | None = None) -> Version:
@@ -160,9 +170,10 @@ def get_version(store: Store, ref: int | str | None = None) -> Version:
             if len(rows) != 1:
                 have = ", ".join(f"{r.id} ({r.name})" for r in rows)
                 raise PreprocessError(
-                    "no preprocessing version; run `suds-exp preprocess` first"
+                    "no preprocessing version; preprocess trials first"
                     if not rows
-                    else f"name the preprocessing version to use (have: {have})"
+                    else f"name the preprocessing version to use (have: {have})",
+                    step="preprocess" if not rows else None,
                 )
             ref = int(rows[0].id)
         row = find_version_row(conn, ref)

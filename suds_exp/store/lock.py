@@ -164,10 +164,11 @@ def holder(db_path, probe: bool = True) -> dict | None:
 
 
 def describe_holder(info: dict | None) -> str:
-    """``info`` of `holder` as words: "`suds-exp run` 'paper' (pid 12, host h)"."""
+    """``info`` of `holder` as words: "run 'paper' (pid 12 on h)" (the step that holds
+    the lock, as `run_campaign` or `suds-exp run`, and what it works on)."""
     if not info:
         return "another process (owner unknown)"
-    what = f"`suds-exp {info.get('command')}`"
+    what = f"{info.get('command')}"
     if info.get("name"):
         what += f" {info['name']!r}"
     return f"{what} (pid {info.get('pid')} on {info.get('host')})"

@@ -22,7 +22,7 @@ def run_readonly(store: Store, query: str) -> pd.DataFrame:
         text = str(exc).strip().splitlines()[0]
         if "read-only" in text or "read only" in text:
             raise StoreError(
-                "refused: this statement would change the database; `suds-exp sql` is read-only"
+                "refused: this statement would change the database; queries here are read-only"
             ) from None
         raise StoreError(f"query failed: {text}") from None
 

@@ -107,7 +107,7 @@ class Store:
     def read(self) -> Iterator[sa.Connection]:
         """A read-only connection; refuses a file that does not exist."""
         if not self.path.exists():
-            raise StoreError(f"{self.path}: no database here; create one with `suds-exp init`")
+            raise StoreError(f"{self.path}: no database here; create one first", step="init")
         # an installation without its migrations is broken for reading too: refuse it in
         # one line here rather than let a later write fail far from the cause
         migrate.available_migrations()

@@ -96,7 +96,7 @@ def run_stream(
         raise StreamError(
             f"warmup_cycles: {settings.warmup_cycles}; expected >= 1 cycle", param="warmup_cycles"
         )
-    change_at = parse_change_at(change_at)
+    change_at = check_change_at(change_at)
     resolve_models(models, "measured")  # a bad learner or parameter: before anything else
     with store.locked("stream", name):
         prep, samples, trials = _stream_samples(store, prep, trials, samples)
@@ -121,42 +121,55 @@ def run_stream(
             for model, params in definition["models"].items()
             if (model, tid) not in done
         ]
-        # Every learner's first unit is computed before anything is stored, so a learner
-        # that cannot run with these settings (too short a warm-up...) is refused with
-        # the database unchanged and the name still free.
-        first: dict[tuple[str, int], pd.DataFrame] = {}
-        for tid, model, params in todo:
-            if not any(m == model for m, _ in first):
-                rows = _unit_rows(by_trial[tid], name, model, params, settings, changes)
-                first[(model, tid)] = rows
-        bar = progress_bar(
-            f"Stream {name}", summary.units, progress, done=summary.done_before, unit="runs"
+
+        def rows_of(tid: int, model: str, params: dict) -> pd.DataFrame:
+            return _unit_rows(by_trial[tid], name, model, params, settings, changes)
+
+        created = _run_units(
+            store, prep, definition, stored, todo, rows_of, summary, progress, on_unit
         )
-        with bar as advance:
-            for tid, model, params in todo:
-                if (model, tid) in first:
-                    rows = first.pop((model, tid))
-                else:
-                    rows = _unit_rows(by_trial[tid], name, model, params, settings, changes)
-                with store.write() as conn:
-                    if stored is None:
-                        _register(conn, name, prep, definition)
-                        stored, summary.created = definition, True
-                    Store.insert_df(conn, "stream_cycles", rows)
-                summary.done_now += 1
-                summary.rows_now += len(rows)
-                advance()
-                if on_unit is not None:
-                    on_unit(summary.done_before + summary.done_now)
-        if stored is None:  # nothing to run (no scored cycle): still record the stream
+        if stored is None and not created:  # nothing to run (no scored cycle): still record it
             with store.write() as conn:
                 _register(conn, name, prep, definition)
-            summary.created = True
+        summary.created = stored is None
     return summary
 
 
-def parse_change_at(value: float | str | None) -> float | None:
-    """``change_at`` as a time in s (> 0), from a number or its text; None stays None."""
+def _run_units(store, prep, definition, stored, todo, rows_of, summary, progress, on_unit) -> bool:
+    """Compute and write each (trial, learner, params) unit of ``todo`` (rows by
+    ``rows_of``), counting them in ``summary``; True when this call stored the stream's
+    definition (with its first rows)."""
+    name = summary.stream
+    # Every learner's first unit is computed before anything is stored, so a learner
+    # that cannot run with these settings (too short a warm-up...) is refused with
+    # the database unchanged and the name still free.
+    first: dict[tuple[str, int], pd.DataFrame] = {}
+    for tid, model, params in todo:
+        if not any(m == model for m, _ in first):
+            first[(model, tid)] = rows_of(tid, model, params)
+    created = False
+    bar = progress_bar(
+        f"Stream {name}", summary.units, progress, done=summary.done_before, unit="runs"
+    )
+    with bar as advance:
+        for tid, model, params in todo:
+            rows = first.pop((model, tid)) if (model, tid) in first else rows_of(tid, model, params)
+            with store.write() as conn:
+                if stored is None and not created:
+                    _register(conn, name, prep, definition)
+                    created = True
+                Store.insert_df(conn, "stream_cycles", rows)
+            summary.done_now += 1
+            summary.rows_now += len(rows)
+            advance()
+            if on_unit is not None:
+                on_unit(summary.done_before + summary.done_now)
+    return created
+
+
+def check_change_at(value: float | None) -> float | None:
+    """``change_at``, a time in s after each trial's start (> 0, a number or its text), as
+    a float; None stays None."""
     if value is None:
         return None
     try:
@@ -281,5 +294,5 @@ def stream_rows(store: Store, name: str) -> pd.DataFrame:
         "SELECT * FROM stream_cycles WHERE stream = ? ORDER BY model, trial_id, cycle", [name]
     )
     if rows.empty and store.query_df("SELECT 1 FROM streams WHERE name = ?", [name]).empty:
-        raise StreamError(f"no stream named {name!r}; start one with `suds-exp stream {name}`")
+        raise StreamError(f"no stream named {name!r}; start one first", step="stream")
     return rows

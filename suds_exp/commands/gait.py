@@ -125,3 +125,36 @@ def connection_command(
 def simulate_file_command(out: Path, gait_file: Path, config=None, **kwargs) -> dict:
     """`simulate --gait-file`: trials of the gait file (see `simulate_gait_file`)."""
     return simulate_gait_file(out, read_gait_file(gait_file), config, **kwargs)
+
+
+def predict_text(doc: dict, learner: str) -> str:
+    """The one line `gait predict` prints for `predict_command`'s document."""
+    ci = doc["interval"].get("forward_mm")
+    return (
+        f"{doc['gait']} at {doc['frequency_hz']:g} Hz ({learner}): forward "
+        f"{doc['forward_mm']:.1f} mm/cycle"
+        + (f" [{ci[0]:.1f}, {ci[1]:.1f}]" if ci else "")
+        + f", lateral {doc['lateral_mm']:.1f} mm, turn {doc['turn_rad']:.3f} rad, "
+        f"mean vx {doc['mean_vx_mm_s']:.1f} mm/s"
+    )
+
+
+def iteration_text(it) -> str:
+    """The line `gait design` prints for each iteration as it is stored."""
+    ach = f", achieved {it.achieved.forward_mm:.1f}" if it.achieved else ""
+    return (
+        f"iteration {it.iteration}: predicted {it.predicted.forward_mm:.1f} mm/cycle"
+        f"{ach}; trust radius {it.trust_radius:.3f} ({it.seconds:.0f} s)"
+    )
+
+
+def connection_lines(summary: dict) -> list[str]:
+    """The lines `gait connection` prints for `connection_command`'s summary."""
+    lines = [f"wrote {summary['csv']} and {summary['figure']}"]
+    if "normalised_rms" in summary:
+        n = summary["normalised_rms"]
+        lines.append(
+            f"normalised RMS difference from the simulator inside the support: vx {n['vx']:.2f}, "
+            f"vy {n['vy']:.2f}, wz {n['wz']:.2f}, mean {n['mean']:.2f} ({n['n_inside']} shapes)"
+        )
+    return lines

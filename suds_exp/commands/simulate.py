@@ -1,5 +1,8 @@
 """The work behind `suds-exp simulate`, `connection` and `effects` (the CLI only parses
-options and prints), plus the parsers of their option strings that the CLI calls."""
+options and prints), plus the parsers of their option strings that the CLI calls.
+
+Simulating then ingesting lives here, above both `suds_exp.sim` and `suds_exp.ingest`,
+which stay independent of each other."""
 
 from __future__ import annotations
 
@@ -15,6 +18,7 @@ from suds_exp.sim.config import SimConfig, load_config
 from suds_exp.sim.connection import local_connection, save_connection
 from suds_exp.sim.dataset import simulate_dataset
 from suds_exp.sim.effects import apply_effects, effect_library
+from suds_exp.sim.schedule import split_effects
 
 
 def parse_gaits(text: str | None) -> tuple[str, ...]:
@@ -183,3 +187,86 @@ def effects_table(config: SimConfig | None = None) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(rows)
+
+
+def simulate_options(
+    out: Path,
+    config_path: Path | None = None,
+    gaits: str | None = None,
+    freqs: str | None = None,
+    repeats: int = 4,
+    cycles: str | None = None,
+    seed: int = 0,
+    effects: Sequence[str] = (),
+    gait_file: Path | None = None,
+    store=None,
+    progress: bool = False,
+) -> dict:
+    """`suds-exp simulate` from its option strings: the paper's design (`simulate_command`)
+    or, with ``gait_file``, trials of that gait (`simulate_file_command`); ingested into
+    ``store`` when one is given. A JSON-ready summary."""
+    if gait_file is not None:
+        return _simulate_gait_file(
+            out,
+            config_path,
+            gaits,
+            freqs,
+            repeats,
+            cycles,
+            seed,
+            effects,
+            gait_file,
+            store,
+            progress,
+        )
+    gait_list, freq_list, cycle_range = parse_gaits(gaits), parse_freqs(freqs), parse_cycles(cycles)
+    static, changes = split_effects(list(effects))
+    return simulate_command(
+        out,
+        build_config(config_path, static),
+        gait_list,
+        freq_list,
+        repeats,
+        cycle_range,
+        seed,
+        changes,
+        store=store,
+        progress=progress,
+    )
+
+
+def _simulate_gait_file(
+    out, config_path, gaits, freqs, repeats, cycles, seed, effects, gait_file, store, progress
+) -> dict:
+    from suds_exp.commands.gait import simulate_file_command
+
+    if gaits:
+        raise ConfigError("use just one of --gaits and --gait-file", param="gaits")
+    if any("@" in e for e in effects):
+        raise ConfigError("--gait-file takes effects without a schedule (NAME=VALUE)")
+    return simulate_file_command(
+        out,
+        gait_file,
+        build_config(config_path, list(effects)),
+        frequencies_hz=parse_freqs(freqs),
+        repeats=repeats,
+        cycles=parse_cycles(cycles),
+        seed=seed,
+        store=store,
+        progress=progress,
+    )
+
+
+def simulate_text(summary: dict) -> str:
+    """The one line `suds-exp simulate` prints for the summary of `simulate_options`."""
+    ingested = f"; ingested trials {summary['trial_ids']}" if summary["trial_ids"] else ""
+    if "gait" in summary:
+        return (
+            f"wrote {summary['n_trials']} trials of {summary['gait']} "
+            f"({summary['simulated_seconds']:.0f} s of robot time) and {summary['manifest']}"
+            + ingested
+        )
+    return (
+        f"wrote {summary['n_trials']} trials ({summary['simulated_seconds']:.0f} s of robot "
+        f"time in {summary['wall_seconds']:.1f} s) and {summary['manifest']}" + ingested
+    )

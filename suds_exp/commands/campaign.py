@@ -1,0 +1,111 @@
+"""`suds-exp run` and `status`: campaign options from their strings, the status table.
+
+The library (`suds_exp.campaign`) takes a `CampaignOptions` of Python values; this module
+reads the command line's strings into one and prints what `campaign_status` returns.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+from collections.abc import Sequence
+
+import pandas as pd
+
+from suds_exp import console
+from suds_exp.campaign.conditions import parse_int_list
+from suds_exp.campaign.definition import (
+    DEFAULTS,
+    CampaignOptions,
+    resolve_models,
+    skipped_cells_text,
+)
+from suds_exp.errors import CampaignError
+from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
+
+
+def parse_campaign_options(
+    *,
+    models: str | None = None,
+    sweep: str | None = None,
+    model_params: Sequence[str] | None = None,
+    **rest,
+) -> CampaignOptions:
+    """Options from command-line strings: ``models="TLS,GMR"`` (``survey`` stands for
+    `SURVEY_LEARNERS`), ``sweep="1-10,21"`` (or ``"paper"``), ``model_params`` as
+    ``["MLP.alpha=0.01", ...]`` (see `parse_model_params`); the rest as in
+    `CampaignOptions`."""
+    names = None if models is None else [m.strip() for m in models.split(",") if m.strip()]
+    if names is not None:
+        names = [n for m in names for n in (SURVEY_LEARNERS if m == "survey" else (m,))]
+    cycles = None if sweep is None else parse_int_list(sweep, "sweep")
+    chosen = names
+    if model_params:
+        chosen = parse_model_params(model_params, names or list(LEARNERS))
+    if chosen is not None:
+        # a bad learner spec fails here, before the database is opened
+        resolve_models(chosen, rest.get("mode") or DEFAULTS.mode)
+    return CampaignOptions(models=chosen, sweep=cycles, **rest)
+
+
+def parse_model_params(items: Sequence[str], names: Sequence[str]) -> dict[str, dict]:
+    """``NAME.KEY=VALUE`` strings -> {name: {key: value}} over every name in ``names``.
+
+    NAME may itself hold dots (``sklearn:pkg.mod.Class``): KEY is what follows the last
+    dot before ``=``. VALUE is read as JSON (``true``, ``0.01``, ``[64, 64]``), else as a
+    Python literal (``(64, 64)``), else kept as text.
+    """
+    out: dict[str, dict] = {n: {} for n in names}
+    for item in items:
+        left, eq, text = item.partition("=")
+        name, dot, key = left.strip().rpartition(".")
+        if not eq or not dot or not name or not key:
+            raise CampaignError(
+                f"model_params {item!r}: expected NAME.KEY=VALUE, e.g. MLP.alpha=0.01",
+                param="model_params",
+            )
+        if name not in out:
+            raise CampaignError(
+                f"model_params {item!r}: learner {name!r} is not in models ({', '.join(names)})",
+                param=("model_params", "models"),
+            )
+        try:
+            value = json.loads(text)
+        except ValueError:
+            try:
+                value = ast.literal_eval(text)
+            except (ValueError, SyntaxError):
+                value = text
+        out[name][key.strip()] = value
+    return out
+
+
+def print_status(status: dict) -> None:
+    """Print `campaign_status` as a per-learner table and one summary line."""
+    frame = pd.DataFrame(status["models"])
+    console.print_frame(frame, title=f"campaign {status['campaign']} (prep {status['prep']})")
+    rate = status["rate_jobs_per_s"]
+    line = f"{status['done']} / {status['total']} jobs done"
+    if status["failed"]:
+        line += f", {status['failed']} failed (see results.error)"
+    if status["running"]:
+        line += " - running"
+        if rate:
+            line += f" at {rate:.2f} jobs/s, about {_duration(status['eta_s'])} left"
+    elif rate:
+        line += f" - not running (last run: {rate:.2f} jobs/s)"
+    console.out.print(line)
+    if status.get("skipped_cells"):
+        console.out.print(
+            "left out (--skip-infeasible; the data cannot supply them): "
+            + skipped_cells_text(status)
+        )
+
+
+def _duration(seconds: float | None) -> str:
+    if seconds is None:
+        return "?"
+    seconds = int(round(seconds))
+    h, rem = divmod(seconds, 3600)
+    m, s = divmod(rem, 60)
+    return f"{h}h{m:02d}m" if h else (f"{m}m{s:02d}s" if m else f"{s}s")

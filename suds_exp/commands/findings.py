@@ -1,0 +1,46 @@
+"""`suds-exp findings`: the findings table and what the passive shape adds, on the terminal."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from suds_exp import console
+from suds_exp.analysis.findings import (
+    PASSIVE_EXPLANATION,
+    campaign_passive_information,
+    findings,
+    findings_display,
+    findings_headline,
+    findings_json,
+    passive_display,
+)
+
+
+def show_findings(store, name: str, n_boot: int = 400, seed: int = 0, as_json=False) -> None:
+    """Measure the findings of campaign ``name`` and what the passive shape adds, and print
+    them: tables and headline, or one JSON document (`findings_json` with a
+    ``passive_information`` list)."""
+    table = findings(store, name, n_boot=n_boot, seed=seed)
+    passive = campaign_passive_information(store, name, n_boot=n_boot, seed=seed)
+    if as_json:
+        doc = findings_json(table, name)
+        doc["passive_information"] = passive.to_dict(orient="records")
+        console.print_json(doc)
+    else:
+        print_findings(table, name)
+        print_passive_information(passive)
+
+
+def print_findings(table: pd.DataFrame, campaign: str) -> None:
+    """Print the findings table and its headline on the terminal."""
+    console.print_frame(findings_display(table), title=f"the paper's findings on {campaign}")
+    console.out.print(findings_headline(table))
+
+
+def print_passive_information(table: pd.DataFrame) -> None:
+    """Print the passive-information table and its explanation on the terminal."""
+    if table.empty:
+        console.out.print("what the passive shape adds: not measurable (no stored samples)")
+        return
+    console.print_frame(passive_display(table), title="what the passive shape adds")
+    console.out.print(PASSIVE_EXPLANATION)

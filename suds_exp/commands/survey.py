@@ -1,0 +1,22 @@
+"""`suds-exp survey`: the survey's tables and sentence on the terminal."""
+
+from __future__ import annotations
+
+from suds_exp import console
+from suds_exp.commands.messages import user_message
+
+
+def print_survey(tables: dict, cycles: int) -> None:
+    """Print `survey_tables`' tables (cycles to target, timing, GLM), the data-ratio
+    sentence and why anything was left out, in the command line's words."""
+    from suds_exp.analysis.survey import ratio_sentence
+
+    if "cycles" in tables:
+        console.print_frame(tables["cycles"].round(2), title="cycles to target (median RMSE vx)")
+    console.print_frame(tables["timing"].round(3), title="median fit / predict seconds")
+    if "glm" in tables:
+        console.print_frame(tables["glm"].round(3), title="GLM, learner as a factor (100 ln)")
+    if "ratio" in tables:
+        console.out.print(ratio_sentence(tables["ratio"], cycles))
+    for why in tables.get("missing", []):
+        console.out.print(f"left out: {user_message(why)}")
