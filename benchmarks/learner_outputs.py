@@ -27,54 +27,21 @@ import sys
 
 import numpy as np
 import pandas as pd
+from learner_setup import GMR_VARIANTS, PAPER, SURVEY, swimmer_samples
 
 from suds_exp.models import make_model
-from suds_exp.testing.synthetic_swimmer import make_samples
 
-CASES = [
-    ("phase-only", {}),
-    ("TLS", {}),
-    ("TLS+SUDS", {}),
-    ("TLS+SUDS", {"mode": "rollout"}),
-    ("GMR", {}),
-    ("GMR+SUDS", {}),
-    ("GMR+SUDS", {"mode": "rollout"}),
-    ("GMR", {"augment": "dilation"}),
-    ("GMR", {"augment": "none", "branching": "filter"}),
-    ("GMR+SUDS", {"branching": "history"}),
-    ("GMR+SUDS", {"branching": "filter", "mode": "rollout"}),
-    ("GMR", {"select_k": "bic", "k_candidates": (4, 8)}),
-    ("MLP", {"random_state": 0}),
-    ("MLP+SUDS", {"random_state": 0}),
-    ("MLP+SUDS", {"random_state": 0, "mode": "rollout"}),
-    ("GBT", {"random_state": 0}),
-    ("kNN", {}),
-    ("KRR", {"random_state": 0}),
-]
-
-
-def _samples(n_cycles, gait, f, seed, tid):
-    return make_samples(
-        n_cycles,
-        gait=gait,
-        frequency_hz=f,
-        passive="travel",
-        velocity="finsler",
-        noise_r=0.005,
-        noise_dr=0.05,
-        seed=seed,
-        first_trial_id=tid,
-    )
+CASES = [*PAPER, *GMR_VARIANTS, *SURVEY]
 
 
 def data():
     """(training frame of two trials, {test name: frame})."""
-    train = pd.concat([_samples(15, "O", 0.5, 11, 1), _samples(15, "O", 0.5, 12, 2)])
+    train = pd.concat([swimmer_samples(15, "O", 0.5, 11, 1), swimmer_samples(15, "O", 0.5, 12, 2)])
     train = train.reset_index(drop=True)
     tests = {
-        "O@0.5": _samples(10, "O", 0.5, 13, 3),
-        "O@1": _samples(10, "O", 1.0, 14, 4),
-        "D+@0.5": _samples(10, "D+", 0.5, 15, 5),
+        "O@0.5": swimmer_samples(10, "O", 0.5, 13, 3),
+        "O@1": swimmer_samples(10, "O", 1.0, 14, 4),
+        "D+@0.5": swimmer_samples(10, "D+", 0.5, 15, 5),
     }
     return train, tests
 

@@ -44,11 +44,11 @@ from statistics import median
 
 import numpy as np
 import pandas as pd
+from learner_setup import PAPER, SURVEY, swimmer_samples
 
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
 from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
-from suds_exp.testing.synthetic_swimmer import make_samples
 
 SAMPLES_PER_CYCLE = 100
 #: The learners `--models survey` adds to the paper's five.
@@ -108,17 +108,7 @@ def _synthetic_trials(conditions, n_cycles, repeats, seed):
     for gait, f in conditions:
         for _ in range(repeats):
             out.setdefault((gait, f), []).append(
-                make_samples(
-                    n_cycles,
-                    gait=gait,
-                    frequency_hz=f,
-                    passive="travel",
-                    velocity="finsler",
-                    noise_r=0.005,
-                    noise_dr=0.05,
-                    seed=seed * 1000 + tid,
-                    first_trial_id=tid,
-                )
+                swimmer_samples(n_cycles, gait, f, seed * 1000 + tid, tid)
             )
             tid += 1
     return out
@@ -137,22 +127,7 @@ def timings(trials, repeats):
     base = trials[("O", 0.5)]
     train = {30: _window(base[0], 0, 30), 48: pd.concat([base[0], _window(base[1], 0, 18)])}
     test = _window(base[2], 0, 20)
-    learners = [
-        ("phase-only", {}),
-        ("TLS", {}),
-        ("TLS+SUDS", {}),
-        ("TLS+SUDS", {"mode": "rollout"}),
-        ("GMR", {}),
-        ("GMR+SUDS", {}),
-        ("GMR+SUDS", {"mode": "rollout"}),
-        # the survey's scikit-learn baselines (suds_exp/models/sklearn_adapter.py)
-        ("MLP", {"random_state": 0}),
-        ("MLP+SUDS", {"random_state": 0}),
-        ("MLP+SUDS", {"random_state": 0, "mode": "rollout"}),
-        ("GBT", {"random_state": 0}),
-        ("kNN", {}),
-        ("KRR", {"random_state": 0}),
-    ]
+    learners = [*PAPER, *SURVEY]
     print("\n## 1. Fit and predict time (s), medians of", repeats, "runs; test trial", len(test))
     print(
         "| learner | train samples | fit s | predict s | fit+predict s | fit+predict CPU s "

@@ -3,54 +3,61 @@
 import sqlalchemy as sa
 
 from suds_exp.campaign.grid import KEY_COLUMNS
+from suds_exp.store.declare import declare_table
 
 metadata = sa.MetaData()
 
-campaigns = sa.Table(
+campaigns = declare_table(
     "campaigns",
     metadata,
-    sa.Column("name", sa.String, primary_key=True),
-    sa.Column("prep_version", sa.String, nullable=False),
-    sa.Column("definition", sa.String, nullable=False),
-    sa.Column("n_jobs", sa.Integer, nullable=False),
-    sa.Column("created_at", sa.DateTime, nullable=False),
+    """
+    name                      String    key
+    prep_version              String    required
+    definition                String    required
+    n_jobs                    Integer   required
+    created_at                DateTime  required
+    """,
 )
 
-campaign_runs = sa.Table(
+campaign_runs = declare_table(
     "campaign_runs",
     metadata,
-    sa.Column("id", sa.Integer, primary_key=True),
-    sa.Column("campaign", sa.String, nullable=False),
-    sa.Column("started_at", sa.DateTime, nullable=False),
-    sa.Column("pid", sa.Integer, nullable=False),
-    sa.Column("host", sa.String, nullable=False),
-    sa.Column("backend", sa.String, nullable=False),
-    sa.Column("n_workers", sa.Integer, nullable=False),
-    sa.Column("n_pending", sa.Integer, nullable=False),
+    """
+    id                        Integer   key
+    campaign                  String    required
+    started_at                DateTime  required
+    pid                       Integer   required
+    host                      String    required
+    backend                   String    required
+    n_workers                 Integer   required
+    n_pending                 Integer   required
+    """,
 )
 
-results = sa.Table(
+results = declare_table(
     "results",
     metadata,
-    sa.Column("campaign", sa.String, nullable=False),
-    sa.Column("model", sa.String, nullable=False),
-    sa.Column("train_gait", sa.String, nullable=False),
-    sa.Column("train_frequency_hz", sa.Float, nullable=False),
-    sa.Column("test_gait", sa.String, nullable=False),
-    sa.Column("test_frequency_hz", sa.Float, nullable=False),
-    sa.Column("boot", sa.Integer, nullable=False),
-    sa.Column("n_cycles", sa.Integer, nullable=False),
-    sa.Column("train_trials", sa.String, nullable=False),
-    sa.Column("train_ranges", sa.String, nullable=False),
-    sa.Column("test_trial", sa.Integer, nullable=False),
-    sa.Column("test_range", sa.String, nullable=False),
-    sa.Column("rmse_vx", sa.Float),
-    sa.Column("rmse_vy", sa.Float),
-    sa.Column("rmse_wz", sa.Float),
-    sa.Column("n_test", sa.Integer, nullable=False),
-    sa.Column("fit_seconds", sa.Float, nullable=False),
-    sa.Column("predict_seconds", sa.Float, nullable=False),
-    sa.Column("finished_at", sa.DateTime, nullable=False),
-    sa.Column("error", sa.String),
+    """
+    campaign                  String    required
+    model                     String    required
+    train_gait                String    required
+    train_frequency_hz        Float     required
+    test_gait                 String    required
+    test_frequency_hz         Float     required
+    boot                      Integer   required
+    n_cycles                  Integer   required
+    train_trials              String    required
+    train_ranges              String    required
+    test_trial                Integer   required
+    test_range                String    required
+    rmse_vx                   Float
+    rmse_vy                   Float
+    rmse_wz                   Float
+    n_test                    Integer   required
+    fit_seconds               Float     required
+    predict_seconds           Float     required
+    finished_at               DateTime  required
+    error                     String
+    """,
     sa.UniqueConstraint(*KEY_COLUMNS),
 )

@@ -140,6 +140,30 @@ def feature_library(
     """
     t = window_field(windows, "t")
     ra = window_field(windows, "ra")
+    m = _measured_at_windows(windows, samples, t)
+    v = sim[..., :3]
+    cols = [
+        *_motion_columns(v, _rate(v, t), m["acc"], ra, half_middle_mm),
+        *_shape_columns(ra, m["dra"], _rate(m["dra"], t), m),
+        *_course_columns(m["dist"], m["t_trial"], v),
+        *_product_columns(ra, m["dra"]),
+    ]
+    features = [f for f, _ in cols]
+    X = np.stack([x for _, x in cols], axis=-1)
+    X[~np.isfinite(t)] = np.nan
+    return X, features
+
+
+_VELOCITIES = (("v_x", "mm/s"), ("v_y", "mm/s"), ("w_z", "rad/s"))
+
+
+def _measured_at_windows(windows: WindowSet, samples: pd.DataFrame, t: np.ndarray) -> dict:
+    """The measured samples' fields at each window's times, NaN where a window is padded.
+
+    Returns "dra" (n_win, n_s, 2) rad/s, "rp" and "drp" (n_win, n_s, k) with their column
+    names "rp_cols" and "drp_cols", "acc" (n_win, n_s, 3) the measured acceleration,
+    "dist" (n_win, n_s) m travelled and "t_trial" (n_win, n_s) s since the trial's start.
+    """
     n_win, n_s = t.shape
     per = _trial_arrays(samples)
     rp_cols = [c for c in samples.columns if c.startswith("rp_") and samples[c].notna().any()]
@@ -161,14 +185,23 @@ def feature_library(
         dist[k, ok] = tr["dist_m"].to_numpy(float)[idx]
         acc_meas[k, ok] = tr[["acc_vx", "acc_vy", "acc_wz"]].to_numpy(float)[idx]
         t_trial[k, ok] = tt[idx] - tt[0]
-    v = sim[..., :3]
-    acc = _rate(v, t)
-    ddra = _rate(dra, t)
-    cols: list[tuple[Feature, np.ndarray]] = [
-        (Feature("1", "-", "constant"), np.ones((n_win, n_s)))
-    ]
-    vel = (("v_x", "mm/s"), ("v_y", "mm/s"), ("w_z", "rad/s"))
-    for i, (name, unit) in enumerate(vel):
+    return {
+        "dra": dra,
+        "rp": rp,
+        "drp": drp,
+        "rp_cols": rp_cols,
+        "drp_cols": drp_cols,
+        "acc": acc_meas,
+        "dist": dist,
+        "t_trial": t_trial,
+    }
+
+
+def _motion_columns(v, acc, acc_meas, ra, half_middle_mm) -> list[tuple[Feature, np.ndarray]]:
+    """The constant, the model's velocities v (mm/s, rad/s), the measured and the model's
+    accelerations, and the sign features of each segment's sliding."""
+    cols = [(Feature("1", "-", "constant"), np.ones(v.shape[:2]))]
+    for i, (name, unit) in enumerate(_VELOCITIES):
         cols.append((Feature(name, unit, "velocity"), v[..., i]))
     for i, (name, unit) in enumerate(
         zip(("a_x", "a_y", "alpha_z"), ("mm/s^2", "mm/s^2", "rad/s^2"), strict=True)
@@ -184,30 +217,44 @@ def feature_library(
     for i, seg in ((1, "head"), (2, "tail")):
         cols.append((Feature(f"max(u_{seg},0)", "mm/s", "sign"), np.maximum(u[..., i], 0.0)))
     cols.append((Feature("|w_z|", "rad/s", "sign"), np.abs(v[..., 2])))
+    return cols
+
+
+def _shape_columns(ra, dra, ddra, m: dict) -> list[tuple[Feature, np.ndarray]]:
+    """The actuated angles (rad) with their first and second rates, then r_p and dr_p/dt."""
+    cols = []
     for i in range(2):
         cols.append((Feature(f"phi{i + 1}", "rad", "shape"), ra[..., i]))
         cols.append((Feature(f"dphi{i + 1}/dt", "rad/s", "rate"), dra[..., i]))
         cols.append((Feature(f"d2phi{i + 1}/dt2", "rad/s^2", "acceleration"), ddra[..., i]))
-    for i, c in enumerate(rp_cols):
-        cols.append((Feature(c, "mm", "shape"), rp[..., i]))
-    for i, c in enumerate(drp_cols):
-        cols.append((Feature(f"{c[1:]}'", "mm/s", "rate"), drp[..., i]))
-    cols.append((Feature("s", "m", "distance"), dist))
-    cols.append((Feature("t", "s", "time"), t_trial))
-    for i, (name, unit) in enumerate(vel):
+    for i, c in enumerate(m["rp_cols"]):
+        cols.append((Feature(c, "mm", "shape"), m["rp"][..., i]))
+    for i, c in enumerate(m["drp_cols"]):
+        cols.append((Feature(f"{c[1:]}'", "mm/s", "rate"), m["drp"][..., i]))
+    return cols
+
+
+def _course_columns(dist, t_trial, v) -> list[tuple[Feature, np.ndarray]]:
+    """Distance travelled (m) and time into the trial (s), alone and times each velocity."""
+    cols = [(Feature("s", "m", "distance"), dist), (Feature("t", "s", "time"), t_trial)]
+    for i, (name, unit) in enumerate(_VELOCITIES):
         cols.append((Feature(f"s*{name}", f"m {unit}", "distance"), dist * v[..., i]))
         cols.append((Feature(f"t*{name}", f"s {unit}", "time"), t_trial * v[..., i]))
-    cols.append((Feature("phi1*phi2", "rad^2", "product"), ra[..., 0] * ra[..., 1]))
-    cols.append((Feature("dphi1/dt*dphi2/dt", "rad^2/s^2", "product"), dra[..., 0] * dra[..., 1]))
+    return cols
+
+
+def _product_columns(ra, dra) -> list[tuple[Feature, np.ndarray]]:
+    """Products of the actuated angles (rad) and their rates (rad/s)."""
+    cols = [
+        (Feature("phi1*phi2", "rad^2", "product"), ra[..., 0] * ra[..., 1]),
+        (Feature("dphi1/dt*dphi2/dt", "rad^2/s^2", "product"), dra[..., 0] * dra[..., 1]),
+    ]
     for i in range(2):
         cols.append(
             (Feature(f"phi{i + 1}*dphi{i + 1}/dt", "rad^2/s", "product"), ra[..., i] * dra[..., i])
         )
         cols.append((Feature(f"phi{i + 1}^2", "rad^2", "product"), ra[..., i] ** 2))
-    features = [f for f, _ in cols]
-    X = np.stack([x for _, x in cols], axis=-1)
-    X[~np.isfinite(t)] = np.nan
-    return X, features
+    return cols
 
 
 #: Time constants (s) of the lagged copies of each channel (`channel_features`): a

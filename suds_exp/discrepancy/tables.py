@@ -2,25 +2,29 @@
 
 import sqlalchemy as sa
 
+from suds_exp.store.declare import declare_table
+
 metadata = sa.MetaData()
 
-discrepancy_runs = sa.Table(
+discrepancy_runs = declare_table(
     "discrepancy_runs",
     metadata,
-    sa.Column("id", sa.Integer, primary_key=True),
-    sa.Column("name", sa.String, nullable=False),
-    sa.Column("prep_version", sa.String),
-    sa.Column("start_model", sa.String, nullable=False),
-    sa.Column("final_model", sa.String),
-    sa.Column("options", sa.String, nullable=False),
-    sa.Column("train_trials", sa.String, nullable=False),
-    sa.Column("test_trials", sa.String, nullable=False),
-    sa.Column("named_effects", sa.String),
-    sa.Column("outcome", sa.String),
-    sa.Column("report_dir", sa.String),
-    sa.Column("seconds", sa.Float),
-    sa.Column("started_at", sa.DateTime, nullable=False),
-    sa.Column("finished_at", sa.DateTime),
+    """
+    id                        Integer   key
+    name                      String    required
+    prep_version              String
+    start_model               String    required
+    final_model               String
+    options                   String    required
+    train_trials              String    required
+    test_trials               String    required
+    named_effects             String
+    outcome                   String
+    report_dir                String
+    seconds                   Float
+    started_at                DateTime  required
+    finished_at               DateTime
+    """,
 )
 
 STEP_COLUMNS = (

@@ -8,17 +8,14 @@ from (seed, the gait's name, frequency, repeat).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
 from suds_exp.gait.predict import derive_seed
 from suds_exp.gait.shape import Gait
 from suds_exp.sim import SimConfig, simulate_dataset
-from suds_exp.sim.dataset import TrialSpec
+from suds_exp.sim.dataset import TrialSpec, draw_trial
 
 
 def gait_trial_specs(
@@ -35,23 +32,7 @@ def gait_trial_specs(
     for f in frequencies_hz:
         for r in range(1, repeats + 1):
             ent = (int(seed), 100 + code, int(round(f * 1e6)), r)
-            rng = np.random.default_rng(np.random.SeedSequence(ent + (0,)))
-            specs.append(
-                TrialSpec(
-                    gait=gait.name,
-                    frequency_hz=float(f),
-                    repeat=r,
-                    n_cycles=int(rng.integers(cycles[0], cycles[1] + 1)),
-                    phase0=float(rng.uniform(0, 2 * math.pi)),
-                    pose0=(
-                        float(rng.uniform(-300, 300)),
-                        float(rng.uniform(-300, 300)),
-                        float(rng.uniform(-math.pi, math.pi)),
-                    ),
-                    seed=ent,
-                    path=gait.shape,
-                )
-            )
+            specs.append(draw_trial(gait.name, f, r, ent, cycles, path=gait.shape))
     return specs
 
 

@@ -88,14 +88,12 @@ import pandas as pd
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
     Learner,
-    ModelError,
     TimeSeries,
     actuated_columns,
     as_array,
     check_choice,
     check_float,
     check_int,
-    passive_columns,
     require_columns,
     rollout_bounds,
 )
@@ -106,6 +104,7 @@ from suds_exp.models.mixture import (
     responsibilities,
     row_max,
 )
+from suds_exp.models.suds_variant import check_mode, required_passive_columns
 from suds_exp.robot import RA_COLUMNS, VB_COLUMNS
 
 
@@ -471,18 +470,16 @@ class GMRSuds(GMR):
 
     def _validate(self):
         super()._validate()
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)
 
     def _columns(self, samples):
-        rp, drp = passive_columns(samples)
-        if not rp:
-            raise ModelError(f"{self.name}: samples frame has no rp_1.. columns (passive shape)")
+        rp, drp = required_passive_columns(samples, self.name)
         ra, dra = actuated_columns(samples)
         return ra + rp + dra, list(VB_COLUMNS) + drp, rp, drp
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         self._check_fitted()
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
         if self.mode == "measured":
             return self._output_frame(self._predict_measured(samples), samples)

@@ -54,6 +54,7 @@ from suds_exp.models.base import (
 )
 from suds_exp.models.gmr import GMR, GMR_DEFAULTS, GMRSuds
 from suds_exp.models.mixture import Conditional, fit_mixture, log_gaussians
+from suds_exp.models.suds_variant import check_mode
 
 
 @dataclass(frozen=True)
@@ -365,4 +366,4 @@ class OnlineGMRSuds(_OnlineMixin, GMRSuds):
 
     def _validate(self):
         super()._validate()
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)

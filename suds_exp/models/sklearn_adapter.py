@@ -51,6 +51,7 @@ from suds_exp.models.base import (
     rollout_bounds,
 )
 from suds_exp.models.registry import SUDS_SUFFIX
+from suds_exp.models.suds_variant import check_mode
 from suds_exp.robot import VB_COLUMNS
 
 PREFIX = "sklearn:"
@@ -160,7 +161,7 @@ class SklearnLearner(Learner):
                     f"{self.name}: {key}={getattr(self, key)!r}; expected true or false"
                 )
         check_float("speed_floor", self.speed_floor, 0.0, self.name, strict=True)
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)
         check_choice("dtype", self.dtype, DTYPES, self.name)
         rs = self.random_state
         if rs is not None and (isinstance(rs, bool) or not isinstance(rs, int | np.integer)):
@@ -235,7 +236,7 @@ class SklearnLearner(Learner):
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
         self._check_fitted()
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
         if self.suds and self.mode == "rollout":
             return self._output_frame(self._predict_rollout(samples)[0], samples)

@@ -47,14 +47,13 @@ from suds_exp.models.base import (
     TimeSeries,
     actuated_columns,
     as_array,
-    check_choice,
     check_float,
     check_int,
-    passive_columns,
     phase_rate,
     require_columns,
     rollout_bounds,
 )
+from suds_exp.models.suds_variant import check_mode, required_passive_columns
 from suds_exp.robot import VB_COLUMNS
 
 _TWO_PI = 2.0 * np.pi
@@ -392,18 +391,16 @@ class TLSSuds(TLS):
 
     def _validate(self):
         super()._validate()
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)
 
     def _shape_columns(self, samples):
-        rp, drp = passive_columns(samples)
-        if not rp:
-            raise ModelError(f"{self.name}: samples frame has no rp_1.. columns (passive shape)")
+        rp, drp = required_passive_columns(samples, self.name)
         return rp, drp
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy, wz and drp_1..drp_k; rollout mode integrates r_p per trial."""
         self._check_fitted()
-        check_choice("mode", self.mode, ("measured", "rollout"), self.name)
+        check_mode(self.mode, self.name)
         if self.mode == "measured":
             return super().predict(samples)
         r, dra = self._shape_arrays(samples)

@@ -88,29 +88,12 @@ def chain_pose(
     heading : array of shape (n_frames,), rad
         Body +X (tail motor axis -> head motor axis), unwrapped.
     """
-    head_origin, head_angle = frames.head_origin, frames.head_angle
-    tail_origin, tail_angle = frames.tail_origin, frames.tail_angle
     pose = body_pose(frames, joints)
     xy, heading = pose.xy, pose.heading
-    half = joints.length_mm / 2
-    hinge = {"head": np.array([half, 0.0]), "tail": np.array([-half, 0.0])}
-    marks = {
-        "head": local[:, [_ROLE[r] for r in HEAD_RIGID]],
-        "tail": local[:, [_ROLE[r] for r in TAIL_RIGID]],
-    }
-    # each rigid marker relative to its motor axis, in its segment's frame
-    template = {
-        "head": to_frame(marks["head"], head_origin, head_angle).mean(axis=0) - joints.head,
-        "tail": to_frame(marks["tail"], tail_origin, tail_angle).mean(axis=0) - joints.tail,
-    }
-    hinged = local[:, [_ROLE[r] for r in TAIL_HINGED]]
-    circles = [
-        (hinged[:, k], centre - joints.tail, radius)
-        for k, centre, radius in hinge_circles(hinged, tail_origin, tail_angle)
-    ]
+    hinge, marks, template, circles = _segment_markers(local, frames, joints)
     relative = {
-        "head": np.unwrap(head_angle - heading),
-        "tail": np.unwrap(tail_angle - heading),
+        "head": np.unwrap(frames.head_angle - heading),
+        "tail": np.unwrap(frames.tail_angle - heading),
     }
     plane = np.concatenate([marks["head"], marks["tail"]], axis=1)
     for round_ in range(rounds):
@@ -122,18 +105,57 @@ def chain_pose(
             seg: local_polynomial(a, window, polyorder) if window > polyorder else a
             for seg, a in relative.items()
         }
-        # the rigid markers and the circle centres in the body frame, per frame
-        body = np.concatenate(
-            [hinge[seg] + rotate(smooth[seg], template[seg][None]) for seg in ("head", "tail")],
-            axis=1,
+        xy, heading = _pose_given_angles(
+            smooth, hinge, template, circles, plane, heading, newton_steps
         )
-        xy, heading = procrustes(body, plane, heading)
-        if circles:
-            in_body = [
-                (marker, hinge["tail"] + rotate(smooth["tail"], centre[None, None])[:, 0], r)
-                for marker, centre, r in circles
-            ]
-            xy, heading = refine_with_circles(xy, heading, body, plane, in_body, newton_steps)
+    return xy, heading
+
+
+def _segment_markers(local: np.ndarray, frames: SegmentFrames, joints: Joints):
+    """What the pose is fitted to, per segment ("head", "tail").
+
+    Returns ``hinge`` (each motor axis in the body frame, (2,) mm), ``marks`` (its rigid
+    markers in the plane, (n_frames, m, 2) mm), ``template`` (each rigid marker relative
+    to its motor axis in its segment's frame, (m, 2) mm) and ``circles`` (per hinged tail
+    flipper marker: its track (n_frames, 2), circle centre relative to the tail axis (2,)
+    and radius, mm).
+    """
+    half = joints.length_mm / 2
+    hinge = {"head": np.array([half, 0.0]), "tail": np.array([-half, 0.0])}
+    marks = {
+        "head": local[:, [_ROLE[r] for r in HEAD_RIGID]],
+        "tail": local[:, [_ROLE[r] for r in TAIL_RIGID]],
+    }
+    # each rigid marker relative to its motor axis, in its segment's frame
+    template = {
+        "head": to_frame(marks["head"], frames.head_origin, frames.head_angle).mean(axis=0)
+        - joints.head,
+        "tail": to_frame(marks["tail"], frames.tail_origin, frames.tail_angle).mean(axis=0)
+        - joints.tail,
+    }
+    hinged = local[:, [_ROLE[r] for r in TAIL_HINGED]]
+    circles = [
+        (hinged[:, k], centre - joints.tail, radius)
+        for k, centre, radius in hinge_circles(hinged, frames.tail_origin, frames.tail_angle)
+    ]
+    return hinge, marks, template, circles
+
+
+def _pose_given_angles(smooth, hinge, template, circles, plane, heading, newton_steps):
+    """(xy (n, 2) mm, heading (n,) rad) of the body that best places the rigid markers
+    (and the flipper circles) at the segments' relative angles ``smooth`` (rad)."""
+    # the rigid markers and the circle centres in the body frame, per frame
+    body = np.concatenate(
+        [hinge[seg] + rotate(smooth[seg], template[seg][None]) for seg in ("head", "tail")],
+        axis=1,
+    )
+    xy, heading = procrustes(body, plane, heading)
+    if circles:
+        in_body = [
+            (marker, hinge["tail"] + rotate(smooth["tail"], centre[None, None])[:, 0], r)
+            for marker, centre, r in circles
+        ]
+        xy, heading = refine_with_circles(xy, heading, body, plane, in_body, newton_steps)
     return xy, heading
 
 

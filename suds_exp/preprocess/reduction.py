@@ -58,7 +58,27 @@ def _stride(x: np.ndarray, n: int) -> np.ndarray:
     return x[np.linspace(0, len(x) - 1, n).round().astype(int)]
 
 
-class KernelPCAReducer:
+class _NonlinearReducer:
+    """What the nonlinear reducers share: r_p and dr_p/dt both come from one map of the
+    passive state, ``_map(passive, rate=None)``, the map itself or its Jacobian applied
+    to ``rate``."""
+
+    method: str
+
+    def transform(self, passive: np.ndarray) -> np.ndarray:
+        """r_p, array of shape (n_samples, k): dimensionless (kernel PCA), in (-1, 1)
+        (autoencoder)."""
+        return self._map(passive)
+
+    def transform_rate(self, rate: np.ndarray, passive: np.ndarray | None = None) -> np.ndarray:
+        """dr_p/dt (n_samples, k) 1/s: the map's Jacobian at ``passive`` (n, 12) mm applied
+        to ``rate`` (n, 12) mm/s."""
+        if passive is None:
+            raise ValueError(f"{self.method}: the rate of r_p needs the passive state")
+        return self._map(passive, rate)
+
+
+class KernelPCAReducer(_NonlinearReducer):
     """RBF kernel PCA of the passive 12-vector, k coordinates (see the module docstring).
 
     Attributes (after `fit`): ``landmarks_`` (m, 12) mm, ``gamma_`` (1/mm^2),
@@ -100,7 +120,8 @@ class KernelPCAReducer:
         )
         return np.exp(-self.gamma_ * np.clip(d2, 0.0, None))
 
-    def _blocks(self, passive, rate=None):
+    def _map(self, passive, rate=None):
+        # in blocks of _BLOCK samples: the kernel against every landmark is (n, m)
         x = np.asarray(passive, dtype=float)
         v = None if rate is None else np.asarray(rate, dtype=float)
         out = np.empty((len(x), self.n_components))
@@ -117,17 +138,6 @@ class KernelPCAReducer:
                 centred = dk - dk.mean(1, keepdims=True)
             out[s : s + _BLOCK] = centred @ self.alphas_
         return out
-
-    def transform(self, passive: np.ndarray) -> np.ndarray:
-        """r_p, array of shape (n_samples, k), dimensionless."""
-        return self._blocks(passive)
-
-    def transform_rate(self, rate: np.ndarray, passive: np.ndarray | None = None) -> np.ndarray:
-        """dr_p/dt (n_samples, k) 1/s: the Jacobian at ``passive`` (n, 12) mm applied to
-        ``rate`` (n, 12) mm/s."""
-        if passive is None:
-            raise ValueError("kernel-pca: the rate of r_p needs the passive state")
-        return self._blocks(passive, rate)
 
     def to_dict(self) -> dict:
         return {
@@ -153,7 +163,7 @@ class KernelPCAReducer:
         return r
 
 
-class AutoencoderReducer:
+class AutoencoderReducer(_NonlinearReducer):
     """A scikit-learn MLP autoencoder of the passive 12-vector with a k-unit bottleneck.
 
     Attributes (after `fit`): ``mean_`` (12,) mm, ``scale_`` mm, ``weights_`` and
@@ -194,7 +204,7 @@ class AutoencoderReducer:
         self.explained_variance_ratio_ = np.array([1.0 - (residual**2).sum() / (z**2).sum()])
         return self
 
-    def _encode(self, passive, rate=None):
+    def _map(self, passive, rate=None):
         h = (np.asarray(passive, dtype=float) - self.mean_) / self.scale_
         dh = None if rate is None else np.asarray(rate, dtype=float) / self.scale_
         for w, b in zip(self.weights_, self.biases_, strict=True):
@@ -202,17 +212,6 @@ class AutoencoderReducer:
             if dh is not None:
                 dh = (1.0 - h * h) * (dh @ w)
         return h if dh is None else dh
-
-    def transform(self, passive: np.ndarray) -> np.ndarray:
-        """r_p, array of shape (n_samples, k), in (-1, 1)."""
-        return self._encode(passive)
-
-    def transform_rate(self, rate: np.ndarray, passive: np.ndarray | None = None) -> np.ndarray:
-        """dr_p/dt (n_samples, k) 1/s: the encoder's Jacobian at ``passive`` (n, 12) mm
-        applied to ``rate`` (n, 12) mm/s."""
-        if passive is None:
-            raise ValueError("autoencoder: the rate of r_p needs the passive state")
-        return self._encode(passive, rate)
 
     def to_dict(self) -> dict:
         return {

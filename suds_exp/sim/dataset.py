@@ -100,27 +100,41 @@ def plan_trials(
             cond = trial_seed(seed, g, f, 0)
             strata = np.random.default_rng(np.random.SeedSequence(cond + (4,))).permutation(repeats)
             for r in range(1, repeats + 1):
-                ent = trial_seed(seed, g, f, r)
-                rng = np.random.default_rng(np.random.SeedSequence(ent + (0,)))
                 j = int(strata[r - 1])
                 c_lo = lo + (j * span) // repeats
                 c_hi = max(c_lo, lo + ((j + 1) * span) // repeats - 1)
-                specs.append(
-                    TrialSpec(
-                        gait=g,
-                        frequency_hz=float(f),
-                        repeat=r,
-                        n_cycles=int(rng.integers(c_lo, c_hi + 1)),
-                        phase0=float(rng.uniform(0, 2 * math.pi)),
-                        pose0=(
-                            float(rng.uniform(-300, 300)),
-                            float(rng.uniform(-300, 300)),
-                            float(rng.uniform(-math.pi, math.pi)),
-                        ),
-                        seed=ent,
-                    )
-                )
+                specs.append(draw_trial(g, f, r, trial_seed(seed, g, f, r), (c_lo, c_hi)))
     return specs
+
+
+def draw_trial(
+    gait: str,
+    frequency_hz: float,
+    repeat: int,
+    seed: tuple[int, ...],
+    cycles: tuple[int, int],
+    path: Callable | None = None,
+) -> TrialSpec:
+    """The trial of (gait, frequency_hz Hz, repeat) with its randomness drawn from `seed`.
+
+    Its cycle count is drawn from ``cycles`` (MIN, MAX), its start phase (rad) and start
+    pose (x, y mm in [-300, 300], heading rad) from the stream ``seed + (0,)``.
+    """
+    rng = np.random.default_rng(np.random.SeedSequence(seed + (0,)))
+    return TrialSpec(
+        gait=gait,
+        frequency_hz=float(frequency_hz),
+        repeat=repeat,
+        n_cycles=int(rng.integers(cycles[0], cycles[1] + 1)),
+        phase0=float(rng.uniform(0, 2 * math.pi)),
+        pose0=(
+            float(rng.uniform(-300, 300)),
+            float(rng.uniform(-300, 300)),
+            float(rng.uniform(-math.pi, math.pi)),
+        ),
+        seed=seed,
+        path=path,
+    )
 
 
 def drive(spec: TrialSpec, cfg: SimConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

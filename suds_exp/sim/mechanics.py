@@ -215,10 +215,7 @@ def simulate_prescribed(
         raise ConfigError(f"dt: expected a positive sample interval in s, got {dt}")
     configs = _configs(config, n_trials)
     table = element_table(configs[0])
-    prm = np.stack([pack_params(c) for c in configs])
-    if not commanded:
-        # angles are followed exactly, whatever the servo's settings
-        prm[:, rft.P_SGAIN] = 0.0
+    prm = _trial_params(configs, commanded, trial_seeds)
     lengths = _lengths(phi, n_frames)
     p0, a0 = _initial_state(pose0, flippers0, n_trials)
     bed_modes, bed_scale = _beds(configs, trial_seeds)
@@ -228,18 +225,7 @@ def simulate_prescribed(
             for k, c in enumerate(configs)
         ]
     )
-    if trial_seeds is None:
-        # a replay cannot know the grains a trial met: it sees the mean medium
-        prm[:, rft.P_GSIG] = 0.0
-    out = {
-        "pose": np.full((n_trials, n_max, 3), np.nan),
-        "vel": np.full((n_trials, n_max, 3), np.nan),
-        "flippers": np.full((n_trials, n_max, 4), np.nan),
-        "phi": np.full((n_trials, n_max, 2), np.nan),
-        "residual": np.full((n_trials, n_max), np.nan),
-        "iterations": np.zeros(n_trials, dtype=np.int64),
-        "continuations": np.zeros(n_trials, dtype=np.int64),
-    }
+    out = _empty_outputs(n_trials, n_max)
     rft.run_trials(
         np.ascontiguousarray(phi),
         lengths,
@@ -258,6 +244,31 @@ def simulate_prescribed(
     if single:
         out = {k: v[0] for k, v in out.items()}
     return out
+
+
+def _trial_params(configs: list[SimConfig], commanded: bool, trial_seeds) -> np.ndarray:
+    """The kernel's parameter rows (n_trials, n_params) of `configs`, as the drive needs."""
+    prm = np.stack([pack_params(c) for c in configs])
+    if not commanded:
+        # angles are followed exactly, whatever the servo's settings
+        prm[:, rft.P_SGAIN] = 0.0
+    if trial_seeds is None:
+        # a replay cannot know the grains a trial met: it sees the mean medium
+        prm[:, rft.P_GSIG] = 0.0
+    return prm
+
+
+def _empty_outputs(n_trials: int, n_max: int) -> dict[str, np.ndarray]:
+    """`simulate_prescribed`'s result arrays, NaN (counts zero) until the kernel fills them."""
+    return {
+        "pose": np.full((n_trials, n_max, 3), np.nan),
+        "vel": np.full((n_trials, n_max, 3), np.nan),
+        "flippers": np.full((n_trials, n_max, 4), np.nan),
+        "phi": np.full((n_trials, n_max, 2), np.nan),
+        "residual": np.full((n_trials, n_max), np.nan),
+        "iterations": np.zeros(n_trials, dtype=np.int64),
+        "continuations": np.zeros(n_trials, dtype=np.int64),
+    }
 
 
 def _as_batch(phi) -> tuple[np.ndarray, bool]:

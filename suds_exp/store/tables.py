@@ -7,35 +7,41 @@ never reflected from the database.
 
 import sqlalchemy as sa
 
+from suds_exp.store.declare import declare_table
+
 metadata = sa.MetaData()
 
-trials = sa.Table(
+trials = declare_table(
     "trials",
     metadata,
-    sa.Column("id", sa.Integer, primary_key=True),
-    sa.Column("source_file", sa.String, nullable=False),
-    sa.Column("content_hash", sa.String, nullable=False, unique=True),
-    sa.Column("format", sa.String, nullable=False),
-    sa.Column("gait", sa.String),
-    sa.Column("frequency_hz", sa.Float),
-    sa.Column("repeat", sa.Integer),
-    sa.Column("sample_rate_hz", sa.Float, nullable=False),
-    sa.Column("n_frames", sa.Integer, nullable=False),
-    sa.Column("marker_names", sa.ARRAY(sa.String), nullable=False),
-    sa.Column("layout", sa.String),
-    sa.Column("ingested_at", sa.DateTime, nullable=False),
-    sa.Column("notes", sa.String),
+    """
+    id                        Integer   key
+    source_file               String    required
+    content_hash              String    required unique
+    format                    String    required
+    gait                      String
+    frequency_hz              Float
+    repeat                    Integer
+    sample_rate_hz            Float     required
+    n_frames                  Integer   required
+    marker_names              String[]  required
+    layout                    String
+    ingested_at               DateTime  required
+    notes                     String
+    """,
 )
 
-markers = sa.Table(
+markers = declare_table(
     "markers",
     metadata,
-    sa.Column("trial_id", sa.Integer, nullable=False),
-    sa.Column("frame", sa.Integer, nullable=False),
-    sa.Column("t", sa.Float, nullable=False),
-    sa.Column("marker", sa.String, nullable=False),
-    sa.Column("x", sa.Float),
-    sa.Column("y", sa.Float),
-    sa.Column("z", sa.Float),
-    sa.Column("missing", sa.Boolean, nullable=False),
+    """
+    trial_id                  Integer   required
+    frame                     Integer   required
+    t                         Float     required
+    marker                    String    required
+    x                         Float
+    y                         Float
+    z                         Float
+    missing                   Boolean   required
+    """,
 )

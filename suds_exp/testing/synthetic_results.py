@@ -122,6 +122,17 @@ def synthetic_results(
     effects = dict(PAPER_INTERACTIONS if effects is None else effects)
     slopes = {**DEFAULT_SLOPES, **(slopes or {})}
     rng = np.random.default_rng(seed)
+    grid = _job_grid(models, n_cycles, n_boot)
+    y = _planted_log_rmse(grid, effects, slopes, phase_only_offset, max(n_cycles))
+    y += rng.normal(0.0, noise, len(grid))
+    grid["rmse_vx"] = np.exp(y / 100.0)
+    _fill_bookkeeping(grid, campaign, rng)
+    return grid.drop(columns="_steps")
+
+
+def _job_grid(models, n_cycles, n_boot: int) -> pd.DataFrame:
+    """One row per (model, train condition, test condition, n_cycles, boot), with the
+    gait-axis distance between train and test gaits in ``_steps``."""
     conditions = [(g, round(f, 6)) for g in GAIT_AXIS for f in FREQUENCIES_HZ]
     grid = pd.DataFrame(
         [
@@ -142,6 +153,14 @@ def synthetic_results(
     )
     pos = {g: i for i, g in enumerate(GAIT_AXIS)}
     grid["_steps"] = np.abs(grid["train_gait"].map(pos) - grid["test_gait"].map(pos))
+    return grid
+
+
+def _planted_log_rmse(
+    grid: pd.DataFrame, effects: dict, slopes: dict, phase_only_offset: float, max_cycles: int
+) -> np.ndarray:
+    """``100 ln(rmse_vx)`` of each row without noise, shape (n_rows,): the planted GLM
+    terms, phase-only's offset and each model's log-log slope in ``n_cycles``."""
     basic = _indicators(grid)
     y = np.zeros(len(grid))
     for term, coef in effects.items():
@@ -149,10 +168,14 @@ def synthetic_results(
     phase_only = (grid["model"] == PHASE_ONLY).to_numpy()
     y[phase_only] = effects.get("Intercept", 0.0) + phase_only_offset
     slope = grid["model"].map(slopes).fillna(0.0).to_numpy()
-    y += 100.0 * slope * np.log(grid["n_cycles"].to_numpy() / max(n_cycles))
-    y += rng.normal(0.0, noise, len(grid))
+    y += 100.0 * slope * np.log(grid["n_cycles"].to_numpy() / max_cycles)
+    return y
+
+
+def _fill_bookkeeping(grid: pd.DataFrame, campaign: str, rng: np.random.Generator) -> None:
+    """The ``results`` columns other than ``rmse_vx``, in place: rmse_vy (mm/s) and
+    rmse_wz (rad/s) as noise, trials, ranges, timings."""
     n = len(grid)
-    grid["rmse_vx"] = np.exp(y / 100.0)
     grid["rmse_vy"] = np.exp(rng.normal(0.0, 0.3, n))
     grid["rmse_wz"] = np.exp(rng.normal(-3.0, 0.3, n))
     grid["campaign"] = campaign
@@ -168,4 +191,3 @@ def synthetic_results(
     grid["fit_seconds"] = rng.uniform(0.01, 1.0, n)
     grid["predict_seconds"] = rng.uniform(0.01, 0.1, n)
     grid["finished_at"] = pd.Timestamp("2026-01-01")
-    return grid.drop(columns="_steps")
