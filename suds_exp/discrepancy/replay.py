@@ -23,7 +23,7 @@ every trial at distance 0).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -359,13 +359,33 @@ def _window_group(key: tuple, items: list, pca) -> WindowGroup:
 
 
 def _window_config(cfg: SimConfig, d0_m: float, tol: float) -> SimConfig:
-    out = cfg.copy()
-    out.solver.tol = tol
-    c = cfg.effects.medium_compaction.rate_per_m
+    """``cfg`` with the replay's solver tolerance and, for a window starting after d0_m
+    (m), the equivalent compaction parameters. Only the changed parts are new objects
+    (the rest is shared with ``cfg``, never modified): a fit replays thousands of
+    windows and a deep copy of each configuration cost more than its parameters."""
+    ef = cfg.effects
+    c = ef.medium_compaction.rate_per_m
     if c > 0 and d0_m > 0:
         grow = 1.0 + c * d0_m
-        out.effects.drag_anisotropy.normal_scale = cfg.effects.drag_anisotropy.normal_scale * grow
-        out.effects.medium_compaction.rate_per_m = c / grow
+        ef = replace(
+            ef,
+            drag_anisotropy=replace(
+                ef.drag_anisotropy, normal_scale=ef.drag_anisotropy.normal_scale * grow
+            ),
+            medium_compaction=replace(ef.medium_compaction, rate_per_m=c / grow),
+        )
+    return replace(cfg, solver=replace(cfg.solver, tol=tol), effects=ef)
+
+
+def _window_configs(configs: list[SimConfig], d0: np.ndarray, tol: float) -> list[SimConfig]:
+    """One configuration per (config, window), configs outermost; windows whose
+    configuration does not depend on where they start share one object."""
+    out = []
+    for cfg in configs:
+        if cfg.effects.medium_compaction.rate_per_m > 0:
+            out += [_window_config(cfg, float(d), tol) for d in d0]
+        else:
+            out += [_window_config(cfg, 0.0, tol)] * len(d0)
     return out
 
 
@@ -390,9 +410,7 @@ def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
     s = windows.settings
     for g in windows.groups:
         n = len(g.index)
-        batch_cfg = [
-            _window_config(c, float(g.d0[k]), s.solver_tol) for c in configs for k in range(n)
-        ]
+        batch_cfg = _window_configs(configs, g.d0, s.solver_tol)
         phi = np.tile(g.phi, (len(configs), 1, 1))
         sim = simulate_prescribed(phi, g.dt, batch_cfg)
         pose = sim["pose"]  # (n_cfg * n, n_steps, 3)
@@ -410,16 +428,17 @@ def replay(windows: WindowSet, configs: list[SimConfig]) -> np.ndarray:
         vel = np.stack([vx, vy, rates[:, sc, 2]], axis=-1).reshape(len(configs), n, g.n_scored, 3)
         out[:, g.index, : g.n_scored, :3] = vel
         if windows.pca is not None:
-            rp = _passive(windows, g, configs, fine, sim["flippers"], dt_cap)[:, sc]
+            rp = _passive(windows, g, configs, fine, sim["flippers"], dt_cap, sc)[:, sc]
             rp = rp - rp.mean(axis=1, keepdims=True)
             out[:, g.index, : g.n_scored, 3:] = rp.reshape(len(configs), n, g.n_scored, -1)
     return out
 
 
-def _passive(windows, g: WindowGroup, configs, pose_fine, flippers, dt_cap) -> np.ndarray:
+def _passive(windows, g: WindowGroup, configs, pose_fine, flippers, dt_cap, scored) -> np.ndarray:
     """Replayed r_p, (n_configs * n_windows, n_fine, k) mm, the preprocessing's way:
     markers (with the spokes' oscillation) -> coordinates in the segment frames ->
-    smoothing -> PCA projection."""
+    smoothing -> PCA projection. Exact on the frames of the slice ``scored`` (the
+    smoothing's edge frames outside it are left unfitted)."""
     s = windows.settings
     n_b, n_fine = pose_fine.shape[:2]
     n_cfg = len(configs)
@@ -434,13 +453,16 @@ def _passive(windows, g: WindowGroup, configs, pose_fine, flippers, dt_cap) -> n
     pos = rigid_marker_positions(
         configs[0], pose_fine.reshape(-1, 3), phi.reshape(-1, 2), fl.reshape(-1, 4)
     ).reshape(n_b, n_fine, len(MARKER_NAMES), 3)
-    for b in range(n_b):
-        cfg = configs[b // n]
+    for i, cfg in enumerate(configs):
         if cfg.effects.spoke_oscillation.gain == 0:
             continue
+        rows = slice(i * n, (i + 1) * n)
         for name in SPOKE_MARKERS:
             j = MARKER_NAMES.index(name)
-            pos[b, :, j, :2] += spoke_deflection(cfg, pos[b, :, j, :2], dt_cap)
+            # every window of one configuration at once, time along the first axis (the
+            # filter runs along it, each window's numbers as when filtered alone)
+            base = pos[rows, :, j, :2].transpose(1, 0, 2)
+            pos[rows, :, j, :2] += spoke_deflection(cfg, base, dt_cap).transpose(1, 0, 2)
     half = configs[0].geometry.middle_length_mm / 2
     x, y, th = pose_fine[..., 0], pose_fine[..., 1], pose_fine[..., 2]
     c, sn = np.cos(th), np.sin(th)
@@ -459,7 +481,11 @@ def _passive(windows, g: WindowGroup, configs, pose_fine, flippers, dt_cap) -> n
     if s.shape_window_s > 0:
         w = min(_odd_window(s.shape_window_s, dt_cap, s.shape_polyorder), n_fine - 1 + n_fine % 2)
         if w > s.shape_polyorder:
-            passive = savgol_filter(passive, w, s.shape_polyorder, axis=1)
+            # the polynomial edge fits (mode "interp") only set the first and last w // 2
+            # frames, and cost more than the whole filter: skipped when none is scored
+            inside = scored.start >= w // 2 and scored.stop <= n_fine - w // 2
+            mode = "constant" if inside else "interp"
+            passive = savgol_filter(passive, w, s.shape_polyorder, axis=1, mode=mode)
     return windows.pca.transform(passive.reshape(-1, 12)).reshape(n_b, n_fine, -1)
 
 

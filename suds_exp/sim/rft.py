@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 P_CS, P_CF, P_CL, P_GAMMA, P_EPS, P_MU = 0, 1, 2, 3, 4, 5
 P_ASYM, P_NORMAL, P_COMPACT = 6, 7, 8
@@ -884,6 +884,82 @@ def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k, grain_k):
 
 
 @njit(cache=True)
+def _trial_buffers(n_el):
+    """The work arrays of one trial's integration (`_substep`'s ``buf``)."""
+    geo, work = np.empty((n_el, 9)), np.zeros((6, N_UNKNOWN))
+    x, xlast = np.zeros(N_UNKNOWN), np.zeros(N_UNKNOWN)
+    held, ang, amid, uprev = np.zeros(4, dtype=np.bool_), np.zeros(4), np.zeros(4), np.zeros(4)
+    w_eff, w_bed = np.empty(n_el), np.empty(n_el)
+    slip = np.zeros(n_el + N_PARTS)
+    return (geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed, slip)
+
+
+@njit(cache=True)
+def _frame_interval(phi_k, f, nsub, p, state, trial, body, buf, bed_k, grain_k):
+    """The ``nsub`` substeps of frame interval f: the new state, the interval's mean twist
+    (m0, m1 mm/s, m2 rad/s), the largest scaled residual, iterations and continuations."""
+    sum0, sum1, sum2 = 0.0, 0.0, 0.0
+    rmax = 0.0
+    iters, n_cont = 0, 0
+    for sub in range(nsub):
+        state, nr, it, cont = _substep(
+            phi_k, f, sub / nsub, (sub + 1) / nsub, p, state, trial, body, buf, bed_k, grain_k
+        )
+        iters += it
+        if cont:
+            n_cont += 1
+        if nr > rmax:
+            rmax = nr
+        sum0 += state[4]
+        sum1 += state[5]
+        sum2 += state[6]
+    return state, sum0 / nsub, sum1 / nsub, sum2 / nsub, rmax, iters, n_cont
+
+
+@njit(cache=True)
+def _run_trial(k, phi, nf, pose0, ang0, p, el_w, body, dt, bed_k, bed_scale, grain_k, out):
+    """Integrate trial k (``nf`` frames) into row k of the outputs ``out`` (pose, vel,
+    ang_out, phi_out, resid, iters, n_cont; see `run_trials`), with its own work arrays."""
+    pose, vel, ang_out, phi_out, resid, iters, n_cont = out
+    el_part = body[0]
+    buf = _trial_buffers(el_part.shape[0])
+    x, xlast, held, ang, uprev, w_eff = buf[2], buf[3], buf[4], buf[5], buf[7], buf[8]
+    nsub = int(p[P_SUBSTEPS])
+    h = dt / nsub
+    relax = 1.0 if p[P_TAU] <= 0.0 else 1.0 - math.exp(-h / p[P_TAU])
+    trial = (h, 1.0 - math.exp(-h / SERVO_LOAD_TAU), relax, _bed_half_var(bed_k), bed_scale)
+    _start_trial(p, el_w, el_part, ang0, w_eff, ang, held, uprev, x, xlast)
+    servo = p[P_SGAIN] > 0.0
+    r1, r2 = phi[k, 0, 0], phi[k, 0, 1]
+    X, Y, TH = pose0[0], pose0[1], pose0[2]
+    state = (r1, r2, 0.0, 0.0, 0.0, 0.0, 0.0, X, Y, TH, 0.0)
+    iters[k] = 0
+    n_cont[k] = 0
+    _record_frame(k, 0, X, Y, TH, ang, 0.0, r1, r2, pose, ang_out, resid, phi_out)
+    last0, last1, last2 = 0.0, 0.0, 0.0
+    for f in range(nf - 1):
+        state, m0, m1, m2, rmax, it, nc = _frame_interval(
+            phi[k], f, nsub, p, state, trial, body, buf, bed_k, grain_k
+        )
+        iters[k] += it
+        n_cont[k] += nc
+        # the twist centred on frame f: mean of the frame intervals either side
+        vel[k, f, 0] = m0 if f == 0 else 0.5 * (last0 + m0)
+        vel[k, f, 1] = m1 if f == 0 else 0.5 * (last1 + m1)
+        vel[k, f, 2] = m2 if f == 0 else 0.5 * (last2 + m2)
+        last0, last1, last2 = m0, m1, m2
+        j1 = state[0] if servo else phi[k, f + 1, 0]
+        j2 = state[1] if servo else phi[k, f + 1, 1]
+        X, Y, TH = state[7], state[8], state[9]
+        _record_frame(k, f + 1, X, Y, TH, ang, rmax, j1, j2, pose, ang_out, resid, phi_out)
+    # the last frame keeps the last interval's twist (none for a one-frame trial)
+    if nf >= 1:
+        vel[k, nf - 1, 0] = last0
+        vel[k, nf - 1, 1] = last1
+        vel[k, nf - 1, 2] = last2
+
+
+@njit(cache=True, parallel=True)
 def run_trials(
     phi,
     n_steps,
@@ -924,67 +1000,18 @@ def run_trials(
     vel (n_trials, n_frames, 3) body twist vx, vy (mm/s), wz (rad/s), centred on the
     frames; ang_out (n_trials, n_frames, 4); resid (n_trials, n_frames) max scaled
     residual of the solves ending at each frame; iters, n_cont (n_trials,) totals.
+
+    Trials are independent (each has its own work arrays), so they run in parallel on
+    numba's threads; each trial's arithmetic, and so its result, is the same whatever
+    the number of threads.
     """
-    n_el = el_part.shape[0]
     body = (el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side)
-    geo, work = np.empty((n_el, 9)), np.zeros((6, N_UNKNOWN))
-    x, xlast = np.zeros(N_UNKNOWN), np.zeros(N_UNKNOWN)
-    held, ang, amid, uprev = np.zeros(4, dtype=np.bool_), np.zeros(4), np.zeros(4), np.zeros(4)
-    w_eff, w_bed = np.empty(n_el), np.empty(n_el)
-    slip = np.zeros(n_el + N_PARTS)
-    buf = (geo, work, x, xlast, held, ang, amid, uprev, w_eff, w_bed, slip)
-    for k in range(phi.shape[0]):
-        p = prm[k]
-        nsub = int(p[P_SUBSTEPS])
-        h = dt / nsub
-        relax = 1.0 if p[P_TAU] <= 0.0 else 1.0 - math.exp(-h / p[P_TAU])
-        trial = (h, 1.0 - math.exp(-h / SERVO_LOAD_TAU), relax, _bed_half_var(bed[k]), bed_scale[k])
-        _start_trial(p, el_w, el_part, ang0[k], w_eff, ang, held, uprev, x, xlast)
-        slip[:] = 0.0
-        servo = p[P_SGAIN] > 0.0
-        r1, r2 = phi[k, 0, 0], phi[k, 0, 1]
-        X, Y, TH = pose0[k, 0], pose0[k, 1], pose0[k, 2]
-        state = (r1, r2, 0.0, 0.0, 0.0, 0.0, 0.0, X, Y, TH, 0.0)
-        iters[k] = 0
-        n_cont[k] = 0
-        nf = n_steps[k]
-        _record_frame(k, 0, X, Y, TH, ang, 0.0, r1, r2, pose, ang_out, resid, phi_out)
-        last0, last1, last2 = 0.0, 0.0, 0.0
-        for f in range(nf - 1):
-            sum0, sum1, sum2 = 0.0, 0.0, 0.0
-            rmax = 0.0
-            for sub in range(nsub):
-                state, nr, it, cont = _substep(
-                    phi[k], f, sub / nsub, (sub + 1) / nsub, p, state, trial, body, buf, bed[k],
-                    grains[k],
-                )  # fmt: skip
-                iters[k] += it
-                if cont:
-                    n_cont[k] += 1
-                if nr > rmax:
-                    rmax = nr
-                sum0 += state[4]
-                sum1 += state[5]
-                sum2 += state[6]
-            m0, m1, m2 = sum0 / nsub, sum1 / nsub, sum2 / nsub
-            # the twist centred on frame f: mean of the frame intervals either side
-            vel[k, f, 0] = m0 if f == 0 else 0.5 * (last0 + m0)
-            vel[k, f, 1] = m1 if f == 0 else 0.5 * (last1 + m1)
-            vel[k, f, 2] = m2 if f == 0 else 0.5 * (last2 + m2)
-            last0, last1, last2 = m0, m1, m2
-            j1 = state[0] if servo else phi[k, f + 1, 0]
-            j2 = state[1] if servo else phi[k, f + 1, 1]
-            X, Y, TH = state[7], state[8], state[9]
-            _record_frame(k, f + 1, X, Y, TH, ang, rmax, j1, j2, pose, ang_out, resid, phi_out)
-        # the last frame keeps the last interval's twist (none for a one-frame trial)
-        if nf >= 2:
-            vel[k, nf - 1, 0] = last0
-            vel[k, nf - 1, 1] = last1
-            vel[k, nf - 1, 2] = last2
-        elif nf == 1:
-            vel[k, 0, 0] = 0.0
-            vel[k, 0, 1] = 0.0
-            vel[k, 0, 2] = 0.0
+    out = (pose, vel, ang_out, phi_out, resid, iters, n_cont)
+    for k in prange(phi.shape[0]):
+        _run_trial(
+            k, phi, n_steps[k], pose0[k], ang0[k], prm[k], el_w, body, dt, bed[k],
+            bed_scale[k], grains[k], out,
+        )  # fmt: skip
 
 
 @njit(cache=True)

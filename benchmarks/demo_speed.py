@@ -1,0 +1,144 @@
+"""The demo's heavy steps against a baseline commit, same machine, same run.
+
+Usage (from the repository root)::
+
+    .venv/bin/python benchmarks/demo_speed.py [--baseline 3454561] [--rounds 3]
+        [--steps simulate discrepancy]
+
+The baseline's `suds_exp` is exported from git (`git archive`) into a temporary folder
+and its simulator kernels compiled there first (not timed). Rounds alternate a worker
+process on the baseline and one on the working tree (A B A B ...), so a change in the
+machine's load hits both. Each worker runs one step of `suds-exp demo`:
+
+- ``simulate``: the demo's dataset (`simulate_dataset`, the paper's design, seed 0) into a
+  temporary folder;
+- ``discrepancy``: the demo's last act (`demo_discrepancy`, body_inertia hidden, seed 0:
+  simulate, ingest, preprocess, then the discrepancy workflow with its report).
+
+and reports its CPU seconds (user + sys of every thread of the process), its wall seconds
+and a sha256 of what it produced (the simulated files; the workflow's result without its
+timings), so the table says whether the working tree's output is identical to the
+baseline's. Wall seconds are only meaningful on an idle machine; CPU seconds are not
+lowered by running on more threads (the simulator's trials run in parallel), wall is.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import subprocess
+import sys
+import tarfile
+import tempfile
+import time
+from io import BytesIO
+from pathlib import Path
+from statistics import median
+
+ROOT = Path(__file__).resolve().parents[1]
+STEPS = ("simulate", "discrepancy")
+
+
+def _simulate(tmp: Path) -> str:
+    from suds_exp.sim import simulate_dataset
+
+    simulate_dataset(tmp, seed=0, progress=False)
+    h = hashlib.sha256()
+    for path in sorted(tmp.rglob("*")):
+        if path.is_file():
+            h.update(path.name.encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _discrepancy(tmp: Path) -> str:
+    from suds_exp.testing.hidden_effects import demo_discrepancy
+
+    found = demo_discrepancy(effect="body_inertia", seed=0, out=tmp / "report")
+    found.pop("seconds", None)
+    return hashlib.sha256(json.dumps(found, default=repr, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def worker(step: str) -> dict:
+    """{cpu, wall, digest, threads, suds_exp} of one run of ``step`` in this process."""
+    import numba
+
+    import suds_exp
+
+    run = {"simulate": _simulate, "discrepancy": _discrepancy}[step]
+    with tempfile.TemporaryDirectory(prefix="suds-demo-speed-") as tmp:
+        c0, w0 = time.process_time(), time.perf_counter()
+        digest = run(Path(tmp))
+        cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    return {
+        "cpu": cpu,
+        "wall": wall,
+        "digest": digest,
+        "threads": numba.get_num_threads(),
+        "suds_exp": suds_exp.__file__,
+    }
+
+
+def _export(commit: str, folder: Path) -> None:
+    data = subprocess.run(
+        ["git", "archive", commit, "suds_exp"], cwd=ROOT, check=True, capture_output=True
+    ).stdout
+    with tarfile.open(fileobj=BytesIO(data)) as tar:
+        tar.extractall(folder, filter="data")
+
+
+def _run(path: Path, *args: str) -> str:
+    env = dict(os.environ, PYTHONPATH=str(path))
+    res = subprocess.run(
+        [sys.executable, *args], env=env, check=True, capture_output=True, text=True, cwd=path
+    )
+    return res.stdout.splitlines()[-1]
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--baseline", default="3454561")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--steps", nargs="+", choices=STEPS, default=list(STEPS))
+    ap.add_argument("--worker", choices=STEPS, help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.worker:
+        print(json.dumps(worker(a.worker)))
+        return 0
+    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
+        _export(a.baseline, Path(tmp))
+        _run(Path(tmp), "-m", "suds_exp.sim.precompile")  # its kernels' compile, untimed
+        _run(ROOT, "-m", "suds_exp.sim.precompile")
+        runs: dict[str, tuple[list, list]] = {}
+        for step in a.steps:
+            base, now = runs.setdefault(step, ([], []))
+            for _ in range(a.rounds):
+                base.append(json.loads(_run(Path(tmp), __file__, "--worker", step)))
+                now.append(json.loads(_run(ROOT, __file__, "--worker", step)))
+    first = next(iter(runs.values()))
+    print(
+        f"## Demo steps, {a.rounds} rounds alternating; baseline {a.baseline} "
+        f"({first[0][0]['suds_exp']}), now = working tree ({first[1][0]['suds_exp']}), "
+        f"{first[1][0]['threads']} numba threads"
+    )
+    print(
+        "| step | baseline CPU s | now CPU s | baseline wall s | now wall s "
+        "| wall speed-up (median [min, max]) | output |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for step, (base, now) in runs.items():
+        ratios = sorted(b["wall"] / n["wall"] for b, n in zip(base, now, strict=True))
+        same = len({r["digest"] for r in base + now}) == 1
+        print(
+            f"| {step} | {median(r['cpu'] for r in base):.1f} | "
+            f"{median(r['cpu'] for r in now):.1f} | {median(r['wall'] for r in base):.1f} | "
+            f"{median(r['wall'] for r in now):.1f} | {median(ratios):.2f}x "
+            f"[{ratios[0]:.2f}, {ratios[-1]:.2f}] | {'identical' if same else 'DIFFER'} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
