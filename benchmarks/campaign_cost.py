@@ -36,14 +36,15 @@ import json
 import os
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
-from io import BytesIO
 from pathlib import Path
 from statistics import median
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from learner_speed import _export  # noqa: E402  (git archive of the baseline)
 
 
 def worker(boots: int, sweep: list[int]) -> dict:
@@ -108,14 +109,6 @@ def worker(boots: int, sweep: list[int]) -> dict:
     out["learners_cpu"] = time.process_time() - c0
     assert len(jobs) * len(models) == out["jobs"], (len(jobs), out["jobs"])
     return out
-
-
-def _export(commit: str, folder: Path) -> None:
-    data = subprocess.run(
-        ["git", "archive", commit, "suds_exp"], cwd=ROOT, check=True, capture_output=True
-    ).stdout
-    with tarfile.open(fileobj=BytesIO(data)) as tar:
-        tar.extractall(folder, filter="data")
 
 
 def _run(path: Path, a) -> dict:
