@@ -3,7 +3,7 @@
 Usage (from the repository root)::
 
     .venv/bin/python benchmarks/campaign_cost.py [--baseline 3454561] [--rounds 3]
-        [--boots 1] [--sweep 1,4,16,30,48]
+        [--boots 1] [--sweep 1,4,16,30,48] [--writes N]
 
 The baseline's `suds_exp` is exported from git (`git archive`) into a temporary folder;
 rounds alternate a worker process on the baseline and one on the working tree (A B A B
@@ -21,6 +21,10 @@ gaits x 3 frequencies x 4 trials, 100 samples a cycle), runs in-process (``jobs=
    definition, bank, finished keys, run record);
 3. the same jobs' make_model + fit + predict in a bare loop on frames built beforehand:
    the learners' own CPU s.
+
+``--writes N``: instead, the CPU and wall seconds of one batch write of the runner
+(``BATCH_ROWS`` = 500 rows into `results`, one transaction) into a table that grows by a
+batch each time, median of N writes, on the working tree only.
 
 Framework CPU per job = (1 - 2 - 3) / jobs; learners' CPU per job = 3 / jobs. The results
 table of each run is reduced to a sha256 of its rows (key columns and the three RMSEs,
@@ -111,6 +115,37 @@ def worker(boots: int, sweep: list[int]) -> dict:
     return out
 
 
+def write_cost(n_writes: int) -> str:
+    """Median CPU and wall seconds of one 500-row batch write, as the runner makes it."""
+    import campaign as cb
+    import pandas as pd
+
+    from suds_exp.campaign import run_campaign
+    from suds_exp.campaign.runner import BATCH_ROWS
+
+    with tempfile.TemporaryDirectory() as folder:
+        store = cb.fresh_store(Path(folder), "writes")
+        samples = cb.paper_like_samples()
+        run_campaign(store, "bench", cb.small_options(), samples=samples, progress=False)
+        rows = store.query_df("SELECT * FROM results")
+        copies = -(-BATCH_ROWS // len(rows))
+        batch = pd.concat([rows.assign(boot=rows.boot + 100 * i) for i in range(copies)])
+        batch = batch.iloc[:BATCH_ROWS].reset_index(drop=True)
+        cpu, wall = [], []
+        for k in range(n_writes):
+            b = batch.assign(campaign=f"writes-{k}")
+            c0, t0 = time.process_time(), time.perf_counter()
+            with store.write() as conn:
+                store.insert_df(conn, "results", b)
+            cpu.append(time.process_time() - c0)
+            wall.append(time.perf_counter() - t0)
+        total = int(store.query_df("SELECT count(*) AS n FROM results").n[0])
+    return (
+        f"one {BATCH_ROWS}-row write of `results` (table growing to {total} rows): "
+        f"{median(cpu):.4f} CPU s, {median(wall):.4f} wall s (medians of {n_writes})"
+    )
+
+
 def _run(path: Path, a) -> dict:
     env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
     cmd = [sys.executable, __file__, "--worker", "--boots", str(a.boots), "--sweep", a.sweep]
@@ -134,8 +169,12 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--boots", type=int, default=1)
     ap.add_argument("--sweep", default="1,4,16,30,48")
+    ap.add_argument("--writes", type=int, default=0, help="time N batch writes instead")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.writes:
+        print(write_cost(a.writes))
+        return 0
     sweep = [int(x) for x in a.sweep.split(",") if x]
     if a.worker:
         print(json.dumps(worker(a.boots, sweep)))
