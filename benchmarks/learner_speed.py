@@ -3,7 +3,11 @@
 Usage (from the repository root)::
 
     .venv/bin/python benchmarks/learner_speed.py [--baseline c2aa7be] [--rounds 5]
-        [--repeats 5] [--cycles 30]
+        [--repeats 5] [--cycles 30] [--models phase-only,TLS,...,MLP,GBT]
+
+``--models``: the learners to time (default: the paper's five and the rollout mode);
+with the paper's five and more (e.g. the survey's learners) it also prints all learners'
+CPU per job over the five's, the survey grid's cost against the paper's.
 
 The baseline's `suds_exp` is exported from git (`git archive`) into a temporary folder;
 rounds alternate a worker process on the baseline and one on the working tree (A B A B
@@ -34,6 +38,7 @@ from pathlib import Path
 from statistics import median
 
 ROOT = Path(__file__).resolve().parents[1]
+PAPER_FIVE = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
 CASES = [
     ("phase-only", {}),
     ("TLS", {}),
@@ -48,7 +53,15 @@ def _label(name, params):
     return name + "".join(f" {k}={v}" for k, v in sorted(params.items()))
 
 
-def worker(cycles: int, repeats: int, n_jobs: int) -> dict:
+def cases(models: str | None) -> list[tuple[str, dict]]:
+    """`CASES`, or the learners named in ``models`` (comma-separated); a learner outside
+    the paper's five gets random_state=0, so its predictions can be compared."""
+    if not models:
+        return CASES
+    return [(n, {} if n in PAPER_FIVE else {"random_state": 0}) for n in models.split(",")]
+
+
+def worker(cycles: int, repeats: int, n_jobs: int, models: str | None = None) -> dict:
     """{learner: [median CPU s per job, sha256 of its predictions]} in this process."""
     from threadpoolctl import threadpool_limits
 
@@ -76,7 +89,7 @@ def worker(cycles: int, repeats: int, n_jobs: int) -> dict:
             break
     out = {"suds_exp": [0.0, suds_exp.__file__]}
     with threadpool_limits(limits=1):
-        for name, params in CASES:
+        for name, params in cases(models):
             h = hashlib.sha256()
             per_job = []
             for _ in range(repeats):
@@ -101,6 +114,7 @@ def _run(path: Path, a) -> dict:
     env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
     cmd = [sys.executable, __file__, "--worker", "--cycles", str(a.cycles)]
     cmd += ["--repeats", str(a.repeats), "--jobs", str(a.jobs)]
+    cmd += ["--models", a.models] if a.models else []
     res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
     return json.loads(res.stdout.splitlines()[-1])
 
@@ -112,10 +126,11 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--cycles", type=int, default=30)
     ap.add_argument("--jobs", type=int, default=4, help="bootstrap draws per learner")
+    ap.add_argument("--models", default=None, help="learners, comma-separated (default: CASES)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:
-        print(json.dumps(worker(a.cycles, a.repeats, a.jobs)))
+        print(json.dumps(worker(a.cycles, a.repeats, a.jobs, a.models)))
         return 0
     with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
         _export(a.baseline, Path(tmp))
@@ -140,6 +155,15 @@ def main(argv=None) -> int:
             f"| {key} | {median(b):.4f} | {median(n):.4f} | {median(ratios):.2f}x "
             f"[{ratios[0]:.2f}, {ratios[-1]:.2f}] | {'bit-identical' if same else 'DIFFER'} |"
         )
+    if set(PAPER_FIVE) <= set(base[0]) and len(base[0]) > len(PAPER_FIVE):
+        # the survey's cost against the paper's five: per round, all learners' CPU over
+        # the five's (the issue's target: <= 3x)
+        for label, runs in (("baseline", base), ("now", now)):
+            r = [sum(v[0] for v in x.values()) / sum(x[k][0] for k in PAPER_FIVE) for x in runs]
+            print(
+                f"{label}: all {len(runs[0])} learners / the paper's five, CPU per job: "
+                f"{median(r):.2f}x (median of {len(r)} rounds)"
+            )
     return 0
 
 

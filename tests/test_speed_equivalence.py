@@ -59,3 +59,39 @@ def test_the_simulator_kernels_compile_ahead_of_first_use():
     assert compile_kernels() > 0
     for kernel in (rft.run_trials, rft.solve_twists, files._format_into):
         assert kernel.signatures, kernel
+
+
+def test_as_array_is_the_loc_subset_bit_for_bit_in_its_layout():
+    """Learners read their columns one by one (campaign speed); the array must be the
+    one `.loc[:, columns].to_numpy(dtype=float)` gave, Fortran layout included (a BLAS
+    product may round differently on another layout)."""
+    import pandas as pd
+    import pytest
+
+    from suds_exp.models.base import ModelError, as_array
+
+    rng = np.random.default_rng(2)
+    n = 257
+    frame = pd.DataFrame(
+        {
+            "trial_id": np.repeat([3, 4], [100, n - 100]),
+            "ra_1": rng.normal(size=n),
+            "flag": rng.random(n) > 0.5,
+            "dra_1": rng.normal(size=n).astype(np.float32),
+            "cycle": np.arange(n),
+        }
+    )
+    frame["later"] = rng.normal(size=n)  # a second block, as a learner's added column
+    columns = ["later", "ra_1", "trial_id", "dra_1", "flag", "cycle"]
+    want = frame.loc[:, columns].to_numpy(dtype=float, copy=True)
+    got = as_array(frame, tuple(columns), "test")
+    assert _bits_equal(got, want)
+    assert got.flags["F_CONTIGUOUS"] == want.flags["F_CONTIGUOUS"]
+    assert got.flags["C_CONTIGUOUS"] == want.flags["C_CONTIGUOUS"]
+    got[0, 0] = 1e9  # a copy: the frame is untouched
+    assert frame["later"].iloc[0] != 1e9
+    twice = pd.concat([frame[["ra_1"]], frame[["ra_1"]]], axis=1)  # duplicate names
+    assert _bits_equal(as_array(twice, ["ra_1"], "t"), twice.loc[:, ["ra_1"]].to_numpy(float))
+    frame.loc[5, "ra_1"] = np.nan
+    with pytest.raises(ModelError, match="ra_1 hold NaN"):
+        as_array(frame, ["ra_1"], "test")

@@ -71,7 +71,17 @@ def require_columns(samples: pd.DataFrame, columns, model: str) -> None:
 
 def as_array(samples: pd.DataFrame, columns, model: str) -> np.ndarray:
     """Columns as a float array of shape (n_samples, len(columns)); NaN/inf is an error."""
-    x = samples.loc[:, list(columns)].to_numpy(dtype=float, copy=True)
+    columns = list(columns)
+    if samples.columns.is_unique:
+        # Column by column: a quarter of the time of .loc[:, columns].to_numpy() on the
+        # many-block frames learners get (pandas builds an index and a block manager for
+        # the subset first). Same values, and the same Fortran layout that call returns
+        # (BLAS may round differently on another layout).
+        x = np.empty((len(samples), len(columns)), order="F")
+        for j, c in enumerate(columns):
+            x[:, j] = samples[c].to_numpy(dtype=float)
+    else:
+        x = samples.loc[:, columns].to_numpy(dtype=float, copy=True)
     if not np.isfinite(x).all():
         bad = [c for c, ok in zip(columns, np.isfinite(x).all(axis=0), strict=True) if not ok]
         raise ModelError(f"{model}: column(s) {', '.join(bad)} hold NaN or inf values")
