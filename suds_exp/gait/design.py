@@ -57,6 +57,10 @@ from suds_exp.store import Store
 #: lag; a local search from the circle alone stays near it, so the search also starts
 #: from the circle tilted either way (each pulled inside the trust region first).
 LAGS_RAD = (-0.6, 0.0, 0.6)
+#: Amplitudes of the multi-start circles, as fractions of the joint bound, beside the
+#: paper's circle O (1 rad): the forward displacement grows with the enclosed area, and a
+#: local search from 1 rad alone rarely widens the gait to the bound.
+AMPLITUDES_OF_BOUND = (0.95,)
 
 #: Penalty (mm of forward displacement) per rad beyond the bound or the trust radius.
 PENALTY_MM_PER_RAD = 500.0
@@ -86,6 +90,7 @@ class DesignOptions:
     accept_error: float = 0.2
     max_evals: int = 400
     cycles: int = 10
+    amplitude_starts: int = 1
 
     def check(self) -> None:
         if not 0 < self.bound <= 3.0:
@@ -197,6 +202,13 @@ def optimise_gait(
     return best, objective(best)
 
 
+def _circle_starts(opts: DesignOptions) -> list[FourierGait]:
+    """The multi-start circles: radius 1 rad (the paper's O) and `AMPLITUDES_OF_BOUND`
+    of the bound (when below ``amplitude_starts``'s cap), each at every lag of `LAGS_RAD`."""
+    radii = (1.0, *(f * opts.bound for f in AMPLITUDES_OF_BOUND[: opts.amplitude_starts]))
+    return [circle(r, opts.order, lag=d) for r in radii for d in LAGS_RAD]
+
+
 def _fit_inside(gait: FourierGait, support: Support, bound: float, trust: float) -> FourierGait:
     """The start shrunk towards its centre until it is inside bound and trust region."""
     for scale in np.linspace(1.0, 0.3, 15):
@@ -242,7 +254,7 @@ def design_gait(
         name = f"design-{design_id}-it{it}.toml"
         starts = [
             _fit_inside(g, support, opts.bound, trust)
-            for g in (best, *(circle(1.0, opts.order, lag=d) for d in LAGS_RAD))
+            for g in (best, *_circle_starts(opts))
         ]
         gait, _ = optimise_gait(
             lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
