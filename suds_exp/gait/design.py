@@ -91,6 +91,7 @@ class DesignOptions:
     max_evals: int = 400
     cycles: int = 10
     amplitude_starts: int = 1
+    radius_rule: str = "error"
 
     def check(self) -> None:
         if not 0 < self.bound <= 3.0:
@@ -252,10 +253,7 @@ def design_gait(
         fitted = fit_map(samples, opts.learner)
         support = Support.of(decimate(samples))
         name = f"design-{design_id}-it{it}.toml"
-        starts = [
-            _fit_inside(g, support, opts.bound, trust)
-            for g in (best, *_circle_starts(opts))
-        ]
+        starts = [_fit_inside(g, support, opts.bound, trust) for g in (best, *_circle_starts(opts))]
         gait, _ = optimise_gait(
             lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
             support,
@@ -277,7 +275,17 @@ def design_gait(
                 abs(achieved.forward_mm), 1e-9
             )
             used = trust
-            trust = min(opts.trust_max, trust * _radius_factor(error, opts))
+            if opts.radius_rule == "ratio":
+                if not np.isfinite(best_achieved):
+                    best_achieved = simulate_gaits([best], opts.frequency_hz, config)[0].forward_mm
+                factor = _ratio_factor(
+                    achieved.forward_mm - best_achieved,
+                    predicted.forward_mm - fitted.forward(best, opts.frequency_hz),
+                    opts,
+                )
+            else:
+                factor = _radius_factor(error, opts)
+            trust = min(opts.trust_max, trust * factor)
             if achieved.forward_mm > best_achieved:
                 best, best_achieved = gait, achieved.forward_mm
             samples = version.samples()
@@ -301,6 +309,18 @@ def design_gait(
         if progress is not None:
             progress(record)
     return design
+
+
+def _ratio_factor(real_gain: float, predicted_gain: float, opts: DesignOptions) -> float:
+    """The textbook trust-region rule on rho = achieved gain / predicted gain over the
+    best verified gait (mm / mm): grow when rho > 0.75 (the map was right or too
+    cautious), shrink when rho < 0.25 (it promised more than the simulator gave)."""
+    if predicted_gain <= 0:
+        return opts.grow if real_gain > 0 else opts.shrink
+    rho = real_gain / predicted_gain
+    if rho > 0.75:
+        return opts.grow_fast if rho > 1.5 else opts.grow
+    return 1.0 if rho >= 0.25 else opts.shrink
 
 
 def _radius_factor(error: float, opts: DesignOptions) -> float:
