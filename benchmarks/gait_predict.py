@@ -9,7 +9,7 @@ sets of gaits that are not among the five (the simulator runs each the same way,
 
 - `UNSEEN`: twelve gaits in the annulus of shapes the five visit (circles, ellipses,
   phase-shifted ellipses, offset circles, rounded squares), fixed first; each printed
-  with its distance from the data (`Support.gait_distance`, rad). Eight of them leave
+  with its distance from the data (`Support.gait_distance`, rad). Ten of them leave
   the support (distance > `SHAPE_RADIUS`), so this set is not the issue's test.
 - `inside_support(INSIDE_CANDIDATES)`: the candidates within `SHAPE_RADIUS` of the data
   in the (shape, direction) metric: the issue's "inside the data's support".

@@ -47,7 +47,7 @@ def test_gaits_inside_the_support_are_predicted_and_ranked(scored_inside):
 def test_most_of_the_first_unseen_set_leaves_the_support(samples):
     support = Support.of(decimate(samples))
     outside = [g.name for g in UNSEEN() if support.gait_distance(g) > SHAPE_RADIUS]
-    assert len(outside) == 8, outside
+    assert len(outside) == 10, outside
 
 
 def test_unseen_gaits_are_predicted_within_25_percent_median(scored):
@@ -57,7 +57,7 @@ def test_unseen_gaits_are_predicted_within_25_percent_median(scored):
 
 
 @pytest.mark.xfail(
-    reason="measured Spearman 0.76 on this set, 8 of whose 12 gaits leave the data's "
+    reason="measured Spearman 0.76 on this set, 10 of whose 12 gaits leave the data's "
     "support: GMR flattens the phase-shifted ellipses, whose shape velocities leave the "
     "directions the five gaits visit; see docs/results/gait-design.md",
     strict=False,
