@@ -73,7 +73,9 @@ class DesignOptions:
     bound (rad), frequency_hz (Hz), order (Fourier harmonics), trust0 (rad, first trust
     radius), trust_max (rad), grow / grow_fast / shrink (radius factors), accept_error (relative
     prediction error that counts as trusted), max_evals (map evaluations per start),
-    cycles (of a verify trial).
+    cycles (of a verify trial), amplitude_starts (how many of `AMPLITUDES_OF_BOUND` to
+    start from), radius_rule ("error": grow or shrink on the verified prediction's
+    relative error; "ratio": the textbook rule on achieved / predicted gain).
     """
 
     learner: str = GMR
@@ -102,6 +104,11 @@ class DesignOptions:
             raise ConfigError(f"order {self.order}: expected 1..5 harmonics", param="order")
         if not self.frequency_hz > 0:
             raise ConfigError(f"frequency {self.frequency_hz}: must be > 0 Hz", param="freq")
+        if self.radius_rule not in ("error", "ratio"):
+            raise ConfigError(
+                f"radius_rule {self.radius_rule!r}: expected 'error' or 'ratio'",
+                param="radius_rule",
+            )
 
 
 @dataclass
