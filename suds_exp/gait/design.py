@@ -8,9 +8,12 @@ forward displacement per cycle over the Fourier coefficients of both joints (ord
 - the trust region: the gait's distance from the training data in the
   (shape, direction of shape velocity) metric of `suds_exp.gait.support` is at most the
   trust radius. A learned map interpolates; far from its data it guesses. The radius
-  starts small and follows the classical trust-region rule on the verified prediction:
-  it grows (x `grow`) when the simulator achieved what the map predicted within
-  `accept_error`, and shrinks (x `shrink`) when it did not.
+  starts small and follows the textbook trust-region rule on the verified step
+  (``radius_rule="ratio"``): rho = achieved gain / predicted gain over the best verified
+  gait; it grows (x `grow`, x `grow_fast` when rho > 1.5) when rho > 0.75, shrinks
+  (x `shrink`) when rho < 0.25. A map that was too cautious is not punished for it.
+  ``radius_rule="error"`` (the first rule) grows when the simulator achieved the
+  prediction within `accept_error` and shrinks when it did not, either way.
 
 With ``verify`` each designed gait is run on the simulator as a new trial (10 cycles at
 the design frequency through the actuator, like any capture), ingested and preprocessed
@@ -93,7 +96,7 @@ class DesignOptions:
     max_evals: int = 400
     cycles: int = 10
     amplitude_starts: int = 1
-    radius_rule: str = "error"
+    radius_rule: str = "ratio"
 
     def check(self) -> None:
         if not 0 < self.bound <= 3.0:
