@@ -206,6 +206,8 @@ def compare_connections(
     m = learned.inside
     if min_spread > 0 and learned.spread is not None:
         m = m & (np.nan_to_num(learned.spread, nan=-1.0) >= min_spread)
+    if not m.any():  # nothing to compare
+        return dict.fromkeys((*COMPONENTS, "mean"), float("nan")) | {"n_inside": 0}
     for c, comp in enumerate(COMPONENTS):
         diff = learned.A[m, c, :] - reference[m, c, :]
         ref = reference[m, c, :]
