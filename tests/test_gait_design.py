@@ -192,3 +192,12 @@ def test_the_designer_s_tilted_start_is_the_phase_shifted_ellipse():
         np.testing.assert_allclose(
             circle(1.0, 2, lag=lag).shape(theta), ellipse(1.0, 1.0, lag).shape(theta), atol=1e-12
         )
+
+
+def test_an_unknown_trust_radius_rule_is_refused():
+    from suds_exp.errors import ConfigError
+    from suds_exp.gait.design import DesignOptions
+
+    DesignOptions(radius_rule="ratio").check()
+    with pytest.raises(ConfigError, match="radius_rule"):
+        DesignOptions(radius_rule="guess").check()

@@ -8,9 +8,12 @@ forward displacement per cycle over the Fourier coefficients of both joints (ord
 - the trust region: the gait's distance from the training data in the
   (shape, direction of shape velocity) metric of `suds_exp.gait.support` is at most the
   trust radius. A learned map interpolates; far from its data it guesses. The radius
-  starts small and follows the classical trust-region rule on the verified prediction:
-  it grows (x `grow`) when the simulator achieved what the map predicted within
-  `accept_error`, and shrinks (x `shrink`) when it did not.
+  starts small and follows the textbook trust-region rule on the verified step
+  (``radius_rule="ratio"``): rho = achieved gain / predicted gain over the best verified
+  gait; it grows (x `grow`, x `grow_fast` when rho > 1.5) when rho > 0.75, shrinks
+  (x `shrink`) when rho < 0.25. A map that was too cautious is not punished for it.
+  ``radius_rule="error"`` (the first rule) grows when the simulator achieved the
+  prediction within `accept_error` and shrinks when it did not, either way.
 
 With ``verify`` each designed gait is run on the simulator as a new trial (10 cycles at
 the design frequency through the actuator, like any capture), ingested and preprocessed
@@ -57,6 +60,10 @@ from suds_exp.store import Store
 #: lag; a local search from the circle alone stays near it, so the search also starts
 #: from the circle tilted either way (each pulled inside the trust region first).
 LAGS_RAD = (-0.6, 0.0, 0.6)
+#: Amplitudes of the multi-start circles, as fractions of the joint bound, beside the
+#: paper's circle O (1 rad): the forward displacement grows with the enclosed area, and a
+#: local search from 1 rad alone rarely widens the gait to the bound.
+AMPLITUDES_OF_BOUND = (0.95,)
 
 #: Penalty (mm of forward displacement) per rad beyond the bound or the trust radius.
 PENALTY_MM_PER_RAD = 500.0
@@ -69,7 +76,9 @@ class DesignOptions:
     bound (rad), frequency_hz (Hz), order (Fourier harmonics), trust0 (rad, first trust
     radius), trust_max (rad), grow / grow_fast / shrink (radius factors), accept_error (relative
     prediction error that counts as trusted), max_evals (map evaluations per start),
-    cycles (of a verify trial).
+    cycles (of a verify trial), amplitude_starts (how many of `AMPLITUDES_OF_BOUND` to
+    start from), radius_rule ("error": grow or shrink on the verified prediction's
+    relative error; "ratio": the textbook rule on achieved / predicted gain).
     """
 
     learner: str = GMR
@@ -86,6 +95,8 @@ class DesignOptions:
     accept_error: float = 0.2
     max_evals: int = 400
     cycles: int = 10
+    amplitude_starts: int = 1
+    radius_rule: str = "ratio"
 
     def check(self) -> None:
         if not 0 < self.bound <= 3.0:
@@ -96,6 +107,11 @@ class DesignOptions:
             raise ConfigError(f"order {self.order}: expected 1..5 harmonics", param="order")
         if not self.frequency_hz > 0:
             raise ConfigError(f"frequency {self.frequency_hz}: must be > 0 Hz", param="freq")
+        if self.radius_rule not in ("error", "ratio"):
+            raise ConfigError(
+                f"radius_rule {self.radius_rule!r}: expected 'error' or 'ratio'",
+                param="radius_rule",
+            )
 
 
 @dataclass
@@ -197,6 +213,13 @@ def optimise_gait(
     return best, objective(best)
 
 
+def _circle_starts(opts: DesignOptions) -> list[FourierGait]:
+    """The multi-start circles: radius 1 rad (the paper's O) and `AMPLITUDES_OF_BOUND`
+    of the bound (when below ``amplitude_starts``'s cap), each at every lag of `LAGS_RAD`."""
+    radii = (1.0, *(f * opts.bound for f in AMPLITUDES_OF_BOUND[: opts.amplitude_starts]))
+    return [circle(r, opts.order, lag=d) for r in radii for d in LAGS_RAD]
+
+
 def _fit_inside(gait: FourierGait, support: Support, bound: float, trust: float) -> FourierGait:
     """The start shrunk towards its centre until it is inside bound and trust region."""
     for scale in np.linspace(1.0, 0.3, 15):
@@ -242,10 +265,7 @@ def design_gait(
         fitted = fit_map(samples, opts.learner)
         support = Support.of(decimate(samples))
         name = f"design-{design_id}-it{it}.toml"
-        starts = [
-            _fit_inside(g, support, opts.bound, trust)
-            for g in (best, *(circle(1.0, opts.order, lag=d) for d in LAGS_RAD))
-        ]
+        starts = [_fit_inside(g, support, opts.bound, trust) for g in (best, *_circle_starts(opts))]
         gait, _ = optimise_gait(
             lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
             support,
@@ -267,7 +287,17 @@ def design_gait(
                 abs(achieved.forward_mm), 1e-9
             )
             used = trust
-            trust = min(opts.trust_max, trust * _radius_factor(error, opts))
+            if opts.radius_rule == "ratio":
+                if not np.isfinite(best_achieved):
+                    best_achieved = simulate_gaits([best], opts.frequency_hz, config)[0].forward_mm
+                factor = _ratio_factor(
+                    achieved.forward_mm - best_achieved,
+                    predicted.forward_mm - fitted.forward(best, opts.frequency_hz),
+                    opts,
+                )
+            else:
+                factor = _radius_factor(error, opts)
+            trust = min(opts.trust_max, trust * factor)
             if achieved.forward_mm > best_achieved:
                 best, best_achieved = gait, achieved.forward_mm
             samples = version.samples()
@@ -291,6 +321,18 @@ def design_gait(
         if progress is not None:
             progress(record)
     return design
+
+
+def _ratio_factor(real_gain: float, predicted_gain: float, opts: DesignOptions) -> float:
+    """The textbook trust-region rule on rho = achieved gain / predicted gain over the
+    best verified gait (mm / mm): grow when rho > 0.75 (the map was right or too
+    cautious), shrink when rho < 0.25 (it promised more than the simulator gave)."""
+    if predicted_gain <= 0:
+        return opts.grow if real_gain > 0 else opts.shrink
+    rho = real_gain / predicted_gain
+    if rho > 0.75:
+        return opts.grow_fast if rho > 1.5 else opts.grow
+    return 1.0 if rho >= 0.25 else opts.shrink
 
 
 def _radius_factor(error: float, opts: DesignOptions) -> float:

@@ -187,6 +187,19 @@ class GaitPrediction:
         return out
 
 
+def bootstrap_draws(samples: pd.DataFrame, n_boot: int, seed: int):
+    """``n_boot`` samples frames, each the training trials resampled with replacement
+    (draw b seeded by (seed, b)); a trial drawn twice is two series, renumbered 1..n."""
+    ids = np.array(sorted(samples["trial_id"].unique()))
+    groups = dict(tuple(samples.groupby("trial_id", sort=False)))
+    for b in range(n_boot):
+        rng = np.random.default_rng([seed, b])
+        draw = rng.choice(ids, size=len(ids), replace=True)
+        yield pd.concat(
+            [groups[t].assign(trial_id=i + 1) for i, t in enumerate(draw)], ignore_index=True
+        )
+
+
 def predict_gaits(
     samples: pd.DataFrame,
     gaits: Sequence[Gait],
@@ -203,15 +216,7 @@ def predict_gaits(
     fitted = fit_map(samples, learner, params)
     points = [fitted.motion(g, frequency_hz) for g in gaits]
     boots = np.empty((n_boot, len(gaits), len(MOTION_KEYS)))
-    ids = np.array(sorted(samples["trial_id"].unique()))
-    groups = dict(tuple(samples.groupby("trial_id", sort=False)))
-    for b in range(n_boot):
-        rng = np.random.default_rng([seed, b])
-        draw = rng.choice(ids, size=len(ids), replace=True)
-        # each drawn trial is a separate series (duplicates renumbered, not merged)
-        frame = pd.concat(
-            [groups[t].assign(trial_id=i + 1) for i, t in enumerate(draw)], ignore_index=True
-        )
+    for b, frame in enumerate(bootstrap_draws(samples, n_boot, seed)):
         fb = fit_map(frame, learner, params)
         for j, g in enumerate(gaits):
             m = fb.motion(g, frequency_hz)
