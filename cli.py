@@ -770,6 +770,13 @@ def gait_connection(
     gait_file: Annotated[
         list[Path] | None, typer.Option(help="Gait files to overlay; repeatable.")
     ] = None,
+    directions: Annotated[
+        str,
+        typer.Option(
+            help="visited: fit from the shape velocities the data took near each shape; "
+            "uniform: from 16 evenly spaced ones."
+        ),
+    ] = "visited",
     config: SimConfigOption = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -792,6 +799,7 @@ def gait_connection(
         compare,
         build_config(config, []) if config else None,
         gait_file or [],
+        directions,
     )
     if json_:
         console.print_json(summary)

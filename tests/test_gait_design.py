@@ -201,3 +201,34 @@ def test_an_unknown_trust_radius_rule_is_refused():
     DesignOptions(radius_rule="ratio").check()
     with pytest.raises(ConfigError, match="radius_rule"):
         DesignOptions(radius_rule="guess").check()
+
+
+def test_connection_compares_the_learned_map_with_the_simulators(db, tmp_path):
+    out = tmp_path / "conn.csv"
+    docs = {
+        d: json.loads(
+            ok(
+                "gait",
+                "connection",
+                "--out",
+                str(out),
+                "--grid",
+                "7",
+                "--compare",
+                "--directions",
+                d,
+                "--db",
+                str(db),
+                "--json",
+            )
+        )
+        for d in ("visited", "uniform")
+    }
+    for d, doc in docs.items():
+        assert doc["directions"] == d and doc["n_inside"] > 0
+        assert np.isfinite(doc["normalised_rms"]["mean"])
+    assert out.is_file() and out.with_suffix(".png").is_file()
+    r = runner.invoke(
+        app, ["gait", "connection", "--out", str(out), "--directions", "all", "--db", str(db)]
+    )
+    assert r.exit_code == 2 and "--directions" in r.output + (r.stderr or "")

@@ -97,10 +97,15 @@ def connection_command(
     compare: bool = False,
     config: SimConfig | None = None,
     gait_files: Sequence[Path] = (),
+    directions: str = "visited",
 ) -> dict:
     """`gait connection`: the learned connection of version ``prep`` on a grid (CSV at
     ``out``, figure beside it as .png), with ``compare`` the simulator's own connection
-    (flippers locked, ``config``) on the same grid and their normalised difference."""
+    (flippers locked, ``config``) on the same grid and their normalised difference.
+
+    directions: "visited" fits each shape's connection from the shape velocities the data
+    took near it (the learner is only trusted there); "uniform" from 16 evenly spaced ones
+    (see `learned_connection`)."""
     make_model(learner)
     gaits = [read_gait_file(p) for p in gait_files]
     if grid < 3:
@@ -108,13 +113,24 @@ def connection_command(
     samples = get_version(store, prep).samples()
     fitted = fit_map(samples, learner)
     conn = learned_connection(
-        fitted.model, decimate(samples), grid, half_range, k=fitted.k, rp0=fitted.rp0
+        fitted.model,
+        decimate(samples),
+        grid,
+        half_range,
+        k=fitted.k,
+        rp0=fitted.rp0,
+        directions=directions,
     )
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     conn.to_frame().to_csv(out, index=False, float_format="%.8g")
     reference = None
-    summary: dict = {"csv": str(out), "learner": learner, "n_inside": int(conn.inside.sum())}
+    summary: dict = {
+        "csv": str(out),
+        "learner": learner,
+        "directions": directions,
+        "n_inside": int(conn.inside.sum()),
+    }
     if compare:
         reference = local_connection(grid, half_range, "robot", config or SimConfig()).A
         summary["normalised_rms"] = compare_connections(conn, reference)
