@@ -122,3 +122,27 @@ def frequency_name(freq: float) -> str:
         if abs(num - round(num)) < 1e-4:
             return f"{round(num)}/{den}" if den > 1 else f"{round(num)}"
     return f"{freq:g}"
+
+
+def axis_boxplots(
+    results: pd.DataFrame, design, out_dir: Path, n_cycles: int | None = None
+) -> dict[str, Path]:
+    """Write one box-plot figure per declared axis of ``design``
+    (`suds_exp.experiment.ExperimentDesign`): ``boxplot_<axis>.png``, ln RMS error of vx
+    by learner, one panel per pair category along the axis (same / near / far, same /
+    lower / higher, same / different). ``results`` must carry the ``<axis>_pair`` columns
+    (`suds_exp.analysis.design_tables.label_pairs`). Returns name -> path."""
+    rows, size = at_cycles(results, n_cycles)
+    models = learner_order(rows["model"])
+    width = max(4.0, 0.6 * len(models) + 1.5)
+    paths = {}
+    for axis in design.axes:
+        cats = axis.categories
+        fig = Figure(figsize=(len(cats) * width, 4.5), layout="constrained")
+        axes = np.atleast_1d(fig.subplots(1, len(cats), sharey=True))
+        for ax, cat in zip(axes, cats, strict=True):
+            _panel(ax, rows[rows[f"{axis.name}_pair"] == cat], models, f"{cat} {axis.name}")
+        axes[0].set_ylabel(YLABEL)
+        fig.suptitle(f"Prediction error by {axis.name} ({axis.kind}; {size} training cycles)")
+        paths[f"boxplot_{axis.name}"] = _save(fig, out_dir / f"boxplot_{axis.name}.png")
+    return paths

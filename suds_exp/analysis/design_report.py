@@ -1,0 +1,72 @@
+"""The report of a campaign on a user's experiment design (`suds_exp.experiment`).
+
+`write_report` hands over here when given a design other than the paper's: the paper's
+findings and its comparison tables are about its gait and frequency axes, so this report
+holds what any design supports: box plots per declared axis, the category numbers, the
+GLM on the declared axes and the IQR table of the same-condition pairs.
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+from suds_exp.analysis import plots
+from suds_exp.analysis.categories import at_cycles
+from suds_exp.analysis.design_tables import (
+    axis_category_table,
+    design_glm_table,
+    design_iqr_table,
+    label_pairs,
+)
+from suds_exp.analysis.formatting import to_html, write_table
+from suds_exp.analysis.queries import load_results
+from suds_exp.experiment import ExperimentDesign
+from suds_exp.store import Store
+
+
+def write_design_report(
+    store: Store,
+    campaign: str,
+    design: ExperimentDesign,
+    out: Path,
+    n_cycles: int | None = None,
+) -> Path:
+    """Write ``boxplot_<axis>.png`` per axis, ``categories``, ``glm``, ``glm_rmse`` and
+    ``iqr`` as ``.csv`` and ``.md``, and ``index.html`` into ``out``; returns the page."""
+    results = load_results(store, campaign)
+    _, size = at_cycles(results, n_cycles)
+    out.mkdir(parents=True, exist_ok=True)
+    tables = {
+        "categories": axis_category_table(results, design, size),
+        "glm": design_glm_table(results, design, size),
+        "glm_rmse": design_glm_table(results, design, size, response="rmse"),
+        "iqr": design_iqr_table(results, design),
+    }
+    figures = plots.axis_boxplots(label_pairs(results, design), design, out, size)
+    files = {name: write_table(frame, out, name, 3) for name, frame in tables.items()}
+    axes = ", ".join(f"{a.name} ({a.kind})" for a in design.axes) or "none"
+    parts = [
+        "<!doctype html><html><head><meta charset='utf-8'>",
+        f"<title>suds-exp report: {html.escape(campaign)}</title></head><body>",
+        f"<h1>Campaign {html.escape(campaign)}</h1>",
+        f"<p>Experiment {html.escape(design.source)}: axes {html.escape(axes)}; "
+        f"{len(results)} results; box plots and GLMs at {size} training cycles.</p>",
+    ]
+    for name, path in figures.items():
+        parts.append(f"<h2>{html.escape(name)}</h2><img src='{path.name}' alt='{name}'>")
+    for name, frame in tables.items():
+        links = " ".join(f"<a href='{p.name}'>{p.suffix[1:]}</a>" for p in files[name].values())
+        note = ""
+        if name.startswith("glm"):
+            formulas = frame.attrs["formulas"]
+            note = (
+                f"<p>{html.escape(frame.attrs['response'])}; direct: "
+                f"<code>{html.escape(formulas['direct'])}</code>; reference categories: "
+                f"{html.escape(str(frame.attrs['reference']))}</p>"
+            )
+        parts.append(f"<h2>{name}</h2>{note}<p>{links}</p>{to_html(frame, 3)}")
+    parts.append("</body></html>")
+    index = out / "index.html"
+    index.write_text("\n".join(parts), encoding="utf-8")
+    return index
