@@ -162,6 +162,9 @@ def ingest(
         float | None,
         typer.Option(help="Keypoints below this confidence are missing (default 0.6)."),
     ] = None,
+    experiment: Annotated[
+        Path | None, typer.Option(help="TOML of the condition axes (default: the paper's).")
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -173,8 +176,10 @@ def ingest(
     still stored (exit status 2 at the end). Example: suds-exp ingest data/ --manifest
     data/manifest.csv; suds-exp ingest mouse.h5 --fps 30 --mm-per-px 0.1
     """
+    from suds_exp.experiment import load_design
     from suds_exp.ingest import PoseOptions, ingest_paths
 
+    design = load_design(experiment)
     results = ingest_paths(
         open_store(db),
         paths or [],
@@ -183,6 +188,7 @@ def ingest(
         progress=not (quiet or json_),
         keep_going=True,
         pose=PoseOptions(software, fps, mm_per_px, confidence_threshold),
+        design=design,
     )
     # a refusal in the command line's words (a parameter named by its flag)
     results = [
@@ -646,6 +652,9 @@ def report(
     paper: Annotated[
         Path | None, typer.Option(help="Folder of the paper's glm_table.csv and iqr_table.csv.")
     ] = None,
+    experiment: Annotated[
+        Path | None, typer.Option(help="TOML of the condition axes (default: the paper's).")
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -654,8 +663,12 @@ def report(
     Example: suds-exp report paper --out reports/paper   (then open reports/paper/index.html)
     """
     from suds_exp.analysis import write_report
+    from suds_exp.experiment import load_design
 
-    index = write_report(open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs)
+    design = load_design(experiment)
+    index = write_report(
+        open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs, design=design
+    )
     if json_:
         files = sorted(p.name for p in index.parent.iterdir() if p.is_file())
         console.print_json({"index": str(index), "files": files})

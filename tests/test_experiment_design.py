@@ -282,3 +282,76 @@ def test_bad_experiment_descriptions_are_one_line_naming_file_and_entry(tmp_path
     with pytest.raises(ConfigError, match=message) as err:
         load_design(path)
     assert str(err.value).startswith(str(path)) and "\n" not in str(err.value)
+
+
+# -- recordings without conditions ---------------------------------------------------------
+
+
+def test_recordings_without_conditions_run_leave_one_trial_out(tmp_path):
+    from suds_exp.sim import simulate_dataset
+
+    ds = simulate_dataset(tmp_path, gaits=("O",), frequencies_hz=(0.5,), repeats=3, cycles=(6, 7))
+    manifest = tmp_path / "plain.csv"
+    table = pd.read_csv(ds.manifest)[["file", "frequency_hz", "repeat"]]
+    table.to_csv(manifest, index=False)
+    (tmp_path / "none.toml").write_text("# no condition axes\n")
+    design = load_design(tmp_path / "none.toml")
+    assert design.axes == () and design.by_trial
+    store = Store(tmp_path / "plain.duckdb")
+    ingest_paths(store, [], manifest, progress=False, design=design)
+    samples = get_version(store, preprocess(store, progress=False).name).samples()
+    assert set(samples.gait) == {"all"}
+    options = CampaignOptions(models=["phase-only", "TLS"], boots=3, train_cycles=3, sweep=[2])
+    run_campaign(store, "loto", options, samples=samples, progress=False)
+    rows = results(store, "loto")
+    trials = sorted(store.query_df("SELECT id FROM trials").id)
+    for _, draw in rows.groupby(["boot", "n_cycles"]):
+        assert draw.test_trial.nunique() == 1
+    # each boot tests on its own trial: all three trials are left out once per size
+    for _, size in rows[rows.model == "TLS"].groupby("n_cycles"):
+        assert sorted(size.test_trial) == trials
+    for row in rows.itertuples():
+        assert row.test_trial not in json.loads(row.train_trials)
+    index = write_report(store, "loto", tmp_path / "report", design=design)
+    assert "leave-one-trial-out" in index.read_text()
+    iqr = pd.read_csv(tmp_path / "report" / "iqr.csv")
+    assert set(iqr.n_cycles) == {2, 3} and set(iqr.condition) == {"all"}
+
+
+def test_the_cli_takes_an_experiment_on_ingest_and_report(experiment, tmp_path):
+    from typer.testing import CliRunner
+
+    import cli
+
+    store, design, samples, work = experiment
+    run_campaign(store, "user", CampaignOptions(**OPTIONS), samples=samples, progress=False)
+    db = str(store.path)
+    runner = CliRunner()
+    before = _tables(store)
+    bad = user_manifest(work, extra={"temperature": "20"})
+    args = ["ingest", "--manifest", str(bad), "--experiment", str(work / "experiment.toml")]
+    got = runner.invoke(cli.app, [*args, "--db", db])
+    assert got.exit_code == 2 and len(got.output.strip().splitlines()) == 1
+    assert "'temperature'" in got.output
+    assert _tables(store) == before
+    (work / "bad.toml").write_text('[[axis]]\nname = "gait"\nkind = "sorted"\n')
+    got = runner.invoke(
+        cli.app, ["report", "user", "--experiment", str(work / "bad.toml"), "--db", db]
+    )
+    assert got.exit_code == 2 and "kind 'sorted'" in got.output
+    out = tmp_path / "cli_report"
+    got = runner.invoke(
+        cli.app,
+        [
+            "report",
+            "user",
+            "--experiment",
+            str(work / "experiment.toml"),
+            "--out",
+            str(out),
+            "--db",
+            db,
+        ],
+    )
+    assert got.exit_code == 0, got.output
+    assert (out / "boxplot_amplitude.png").is_file() and (out / "glm.csv").is_file()

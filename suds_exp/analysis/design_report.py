@@ -25,6 +25,17 @@ from suds_exp.experiment import ExperimentDesign
 from suds_exp.store import Store
 
 
+#: What a campaign on recordings without conditions measures (the report says it).
+BY_TRIAL_MEANING = (
+    "These recordings carry no condition (no axis but perhaps the gait frequency), so the "
+    "campaign ran by trial: each draw tests on one trial and trains on cycles of the "
+    "others (leave-one-trial-out). Every result is a same-condition result: it measures "
+    "how well a map learned from some recordings predicts another recording of the same "
+    "behaviour (repeatability across trials), not how it transfers to other gaits or "
+    "conditions; there are no similarity categories, and the GLM has no condition terms."
+)
+
+
 def write_design_report(
     store: Store,
     campaign: str,
@@ -33,16 +44,18 @@ def write_design_report(
     n_cycles: int | None = None,
 ) -> Path:
     """Write ``boxplot_<axis>.png`` per axis, ``categories``, ``glm``, ``glm_rmse`` and
-    ``iqr`` as ``.csv`` and ``.md``, and ``index.html`` into ``out``; returns the page."""
+    ``iqr`` as ``.csv`` and ``.md``, and ``index.html`` into ``out``; returns the page.
+    A design without axes (recordings without conditions, run by trial) has only the IQR
+    table, and the page says what the analysis then means (`BY_TRIAL_MEANING`)."""
     results = load_results(store, campaign)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)
-    tables = {
-        "categories": axis_category_table(results, design, size),
-        "glm": design_glm_table(results, design, size),
-        "glm_rmse": design_glm_table(results, design, size, response="rmse"),
-        "iqr": design_iqr_table(results, design),
-    }
+    tables = {}
+    if design.axes:
+        tables["categories"] = axis_category_table(results, design, size)
+        tables["glm"] = design_glm_table(results, design, size)
+        tables["glm_rmse"] = design_glm_table(results, design, size, response="rmse")
+    tables["iqr"] = design_iqr_table(results, design)
     figures = plots.axis_boxplots(label_pairs(results, design), design, out, size)
     files = {name: write_table(frame, out, name, 3) for name, frame in tables.items()}
     axes = ", ".join(f"{a.name} ({a.kind})" for a in design.axes) or "none"
@@ -53,6 +66,8 @@ def write_design_report(
         f"<p>Experiment {html.escape(design.source)}: axes {html.escape(axes)}; "
         f"{len(results)} results; box plots and GLMs at {size} training cycles.</p>",
     ]
+    if design.by_trial:
+        parts.append(f"<p>{html.escape(BY_TRIAL_MEANING)}</p>")
     for name, path in figures.items():
         parts.append(f"<h2>{html.escape(name)}</h2><img src='{path.name}' alt='{name}'>")
     for name, frame in tables.items():

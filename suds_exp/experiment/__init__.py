@@ -2,6 +2,7 @@
 as the built-in default, and how a train/test pair is classified along each axis."""
 
 from suds_exp.experiment.design import (
+    BY_TRIAL_LABEL,
     FREQUENCY_AXIS,
     KINDS,
     PAPER_DESIGN,
@@ -14,6 +15,7 @@ from suds_exp.experiment.design import (
 from suds_exp.experiment.pairs import classify, classify_pair, pair_column
 
 __all__ = [
+    "BY_TRIAL_LABEL",
     "FREQUENCY_AXIS",
     "KINDS",
     "PAPER_DESIGN",

@@ -39,6 +39,9 @@ KINDS = {
 FREQUENCY_AXIS = "frequency_hz"
 #: Manifest columns that are not condition axes.
 RESERVED = ("file", "repeat", "notes")
+#: The condition label of a design with no axis but the frequency: recordings without
+#: conditions, run by trial (leave-one-trial-out, `suds_exp.campaign.sampling`).
+BY_TRIAL_LABEL = "all"
 #: Characters a condition label uses to join axes, so no level may contain them (nor
 #: the `@` and `,` of condition option strings).
 _FORBIDDEN = (";", "=", "@", ",")
@@ -97,6 +100,11 @@ class ExperimentDesign:
         raise ConfigError(f"{self.source}: no axis {name!r}; declared: {', '.join(self.names)}")
 
     @property
+    def by_trial(self) -> bool:
+        """No axis but perhaps the frequency: trials are run leave-one-trial-out."""
+        return not self.label_axes
+
+    @property
     def label_axes(self) -> tuple[Axis, ...]:
         """The axes that make up a condition label (all but the frequency)."""
         return tuple(a for a in self.axes if a.name != FREQUENCY_AXIS)
@@ -107,7 +115,7 @@ class ExperimentDesign:
         none (recordings without conditions)."""
         parts = [(a.name, _text(values[a.name])) for a in self.label_axes]
         if not parts:
-            return "all"
+            return BY_TRIAL_LABEL
         if len(parts) == 1:
             return parts[0][1]
         return ";".join(f"{n}={v}" for n, v in parts)
