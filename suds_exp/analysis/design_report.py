@@ -24,7 +24,6 @@ from suds_exp.analysis.queries import load_results
 from suds_exp.experiment import ExperimentDesign
 from suds_exp.store import Store
 
-
 #: What a campaign on recordings without conditions measures (the report says it).
 BY_TRIAL_MEANING = (
     "These recordings carry no condition (no axis but perhaps the gait frequency), so the "
