@@ -133,6 +133,9 @@ def test_a_user_design_campaign_runs_resumes_and_reports(experiment, tmp_path):
     assert {"gait=same", "gait=far", "frequency_hz=same", "frequency_hz=higher"} <= terms
     assert any(t.startswith("amplitude=") for t in terms)
     assert "model-gait near data-gait" not in index.read_text()
+    assert (out / "sample_efficiency.png").stat().st_size > 1000
+    slopes = pd.read_csv(out / "slopes.csv")
+    assert len(slopes) == 6 * 2 and set(slopes.cycles_to) == {3}
     iqr = pd.read_csv(out / "iqr.csv")
     assert set(iqr.n_cycles) == {1, 2, 3} and (iqr.iqr >= 0).all()
     assert len(iqr[["condition", "frequency_hz"]].drop_duplicates()) == 6

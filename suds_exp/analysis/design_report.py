@@ -17,6 +17,7 @@ from suds_exp.analysis.design_tables import (
     axis_category_table,
     design_glm_table,
     design_iqr_table,
+    design_slope_table,
     label_pairs,
 )
 from suds_exp.analysis.formatting import to_html, write_table
@@ -42,8 +43,9 @@ def write_design_report(
     out: Path,
     n_cycles: int | None = None,
 ) -> Path:
-    """Write ``boxplot_<axis>.png`` per axis, ``categories``, ``glm``, ``glm_rmse`` and
-    ``iqr`` as ``.csv`` and ``.md``, and ``index.html`` into ``out``; returns the page.
+    """Write ``boxplot_<axis>.png`` per axis, ``sample_efficiency.png`` (a panel per
+    condition), ``categories``, ``glm``, ``glm_rmse``, ``iqr`` and ``slopes`` as ``.csv``
+    and ``.md``, and ``index.html`` into ``out``; returns the page.
     A design without axes (recordings without conditions, run by trial) has only the IQR
     table, and the page says what the analysis then means (`BY_TRIAL_MEANING`)."""
     results = load_results(store, campaign)
@@ -55,7 +57,17 @@ def write_design_report(
         tables["glm"] = design_glm_table(results, design, size)
         tables["glm_rmse"] = design_glm_table(results, design, size, response="rmse")
     tables["iqr"] = design_iqr_table(results, design)
+    tables["slopes"] = design_slope_table(results, design)
     figures = plots.axis_boxplots(label_pairs(results, design), design, out, size)
+    iqr, slopes = (
+        t.assign(
+            panel=[f"{c} @ {f:g} Hz" for c, f in zip(t.condition, t.frequency_hz, strict=True)]
+        )
+        for t in (tables["iqr"], tables["slopes"])
+    )
+    figures["sample_efficiency"] = plots.efficiency_figure(
+        iqr, slopes, out / "sample_efficiency.png", panel="panel"
+    )
     files = {name: write_table(frame, out, name, 3) for name, frame in tables.items()}
     axes = ", ".join(f"{a.name} ({a.kind})" for a in design.axes) or "none"
     parts = [

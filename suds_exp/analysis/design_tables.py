@@ -17,6 +17,7 @@ import pandas as pd
 
 from suds_exp.analysis.categories import at_cycles, learner_order
 from suds_exp.analysis.glm import RESPONSES, fit_formula
+from suds_exp.analysis.spread import fit_slopes
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import ExperimentDesign, classify_pair, pair_column
 
@@ -196,6 +197,37 @@ def design_iqr_table(results: pd.DataFrame, design: ExperimentDesign) -> pd.Data
     ``frequency_hz``, ``model``, ``n_cycles``, ``n``, ``q1``, ``median``, ``q3``, ``iqr``
     (mm/s; linear-interpolated quartiles).
     """
+    rows = _same_condition(results, design)
+    grouped = rows.groupby(["condition", "frequency_hz", "model", "n_cycles"])["rmse_vx"]
+    table = grouped.quantile([0.25, 0.5, 0.75]).unstack()
+    table.columns = ["q1", "median", "q3"]
+    table.insert(0, "n", grouped.count())
+    table["iqr"] = table["q3"] - table["q1"]
+    return _ordered(table.reset_index())
+
+
+def design_slope_table(
+    results: pd.DataFrame, design: ExperimentDesign, upper_from: int | None = None
+) -> pd.DataFrame:
+    """Each learner's log-log slope of RMS error of vx against training cycles over the
+    same-condition pairs, per test condition (`suds_exp.analysis.spread.slope_table`'s
+    fit): columns ``condition``, ``frequency_hz``, ``model``, ``slope``, ``ci_low``,
+    ``ci_high``, ``cycles_from``, ``cycles_to``, ``n``."""
+    rows = _same_condition(results, design)
+    return _ordered(fit_slopes(rows, ["condition", "frequency_hz", "model"], upper_from))
+
+
+def _ordered(table: pd.DataFrame) -> pd.DataFrame:
+    order = {m: i for i, m in enumerate(learner_order(table["model"]))}
+    keys = ["condition", "frequency_hz", "model", "n_cycles"]
+    return table.sort_values(
+        [k for k in keys if k in table],
+        key=lambda s: s.map(order) if s.name == "model" else s,
+    ).reset_index(drop=True)
+
+
+def _same_condition(results: pd.DataFrame, design: ExperimentDesign) -> pd.DataFrame:
+    """Results of same-condition pairs, with the test ``condition`` and ``frequency_hz``."""
     labelled = label_pairs(results, design)
     same = np.ones(len(labelled), dtype=bool)
     for axis in design.axes:
@@ -212,15 +244,4 @@ def design_iqr_table(results: pd.DataFrame, design: ExperimentDesign) -> pd.Data
             "no same-condition results (trained and tested on the same condition); the "
             "IQR table and sample-efficiency figure need them"
         )
-    rows = rows.assign(condition=rows["test_gait"], frequency_hz=rows["test_frequency_hz"].round(6))
-    grouped = rows.groupby(["condition", "frequency_hz", "model", "n_cycles"])["rmse_vx"]
-    table = grouped.quantile([0.25, 0.5, 0.75]).unstack()
-    table.columns = ["q1", "median", "q3"]
-    table.insert(0, "n", grouped.count())
-    table["iqr"] = table["q3"] - table["q1"]
-    table = table.reset_index()
-    order = {m: i for i, m in enumerate(learner_order(table["model"]))}
-    return table.sort_values(
-        ["condition", "frequency_hz", "model", "n_cycles"],
-        key=lambda s: s.map(order) if s.name == "model" else s,
-    ).reset_index(drop=True)
+    return rows.assign(condition=rows["test_gait"], frequency_hz=rows["test_frequency_hz"].round(6))
