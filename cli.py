@@ -131,6 +131,9 @@ def ingest(
         float | None,
         typer.Option(help="Keypoints below this confidence are missing (default 0.6)."),
     ] = None,
+    experiment: Annotated[
+        Path | None, typer.Option(help="TOML of the condition axes (default: the paper's).")
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -143,8 +146,10 @@ def ingest(
     data/manifest.csv; suds-exp ingest mouse.h5 --fps 30 --mm-per-px 0.1
     """
     from suds_exp.commands.ingest import print_ingest
+    from suds_exp.experiment import load_design
     from suds_exp.ingest import PoseOptions, ingest_paths
 
+    design = load_design(experiment)
     results = ingest_paths(
         open_store(db),
         paths or [],
@@ -153,6 +158,7 @@ def ingest(
         progress=not (quiet or json_),
         keep_going=True,
         pose=PoseOptions(software, fps, mm_per_px, confidence_threshold),
+        design=design,
     )
     if print_ingest(results, json_):
         raise typer.Exit(2)
@@ -488,6 +494,9 @@ def report(
     paper: Annotated[
         Path | None, typer.Option(help="Folder of the paper's glm_table.csv and iqr_table.csv.")
     ] = None,
+    experiment: Annotated[
+        Path | None, typer.Option(help="TOML of the condition axes (default: the paper's).")
+    ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -497,8 +506,12 @@ def report(
     """
     from suds_exp.analysis import write_report
     from suds_exp.commands.report import report_document
+    from suds_exp.experiment import load_design
 
-    index = write_report(open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs)
+    design = load_design(experiment)
+    index = write_report(
+        open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs, design=design
+    )
     if json_:
         console.print_json(report_document(index))
     else:

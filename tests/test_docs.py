@@ -89,7 +89,12 @@ def test_how_to_guides_run(page, tmp_path, monkeypatch):
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "page",
-    ["how-to/discrepancy.md", "how-to/learner-survey.md", "how-to/streams.md"],
+    [
+        "how-to/discrepancy.md",
+        "how-to/learner-survey.md",
+        "how-to/streams.md",
+        "how-to/own-experiment.md",
+    ],
 )
 def test_long_how_to_guides_run(page, tmp_path, monkeypatch):
     run_page(page, tmp_path, monkeypatch)

@@ -76,21 +76,27 @@ def category_boxplots(
     return paths
 
 
-def efficiency_figure(iqr: pd.DataFrame, slopes: pd.DataFrame, path: Path) -> Path:
+def efficiency_figure(
+    iqr: pd.DataFrame, slopes: pd.DataFrame, path: Path, panel: str = "frequency_hz"
+) -> Path:
     """Write the sample-efficiency figure: median RMS error of vx (line, markers) and its
     inter-quartile band against training cycles, log-log, one panel per frequency, one
     line per learner labelled with its fitted upper-range slope.
 
-    ``iqr`` is `iqr_table` output, ``slopes`` `slope_table` output.
+    ``iqr`` is `iqr_table` output, ``slopes`` `slope_table` output. ``panel``: the column
+    of both whose values make the panels (default the frequency, titled in Hz; another
+    column's values are the titles as they are).
     """
-    freqs = sorted(iqr["frequency_hz"].unique())
+    freqs = sorted(iqr[panel].unique())
     models = learner_order(iqr["model"])
     fig = Figure(figsize=(5.0 * len(freqs), 4.8), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(freqs), sharey=True))
-    slope_of = {(r.frequency_hz, r.model): r.slope for r in slopes.itertuples()}
+    slope_of = dict(
+        zip(zip(slopes[panel], slopes["model"], strict=True), slopes["slope"], strict=True)
+    )
     for ax, freq in zip(axes, freqs, strict=True):
         for k, model in enumerate(models):
-            g = iqr[(iqr["frequency_hz"] == freq) & (iqr["model"] == model)]
+            g = iqr[(iqr[panel] == freq) & (iqr["model"] == model)]
             if g.empty:
                 continue
             s = slope_of.get((freq, model), np.nan)
@@ -104,8 +110,8 @@ def efficiency_figure(iqr: pd.DataFrame, slopes: pd.DataFrame, path: Path) -> Pa
             axis.set_major_formatter(LogFormatter())
             axis.set_minor_formatter(LogFormatter(labelOnlyBase=False, minor_thresholds=(2, 0.4)))
         ax.set_xlabel("training cycles")
-        ax.set_title(f"{frequency_name(freq)} Hz")
-        fitted = slopes[slopes["frequency_hz"] == freq]
+        ax.set_title(f"{frequency_name(freq)} Hz" if panel == "frequency_hz" else str(freq))
+        fitted = slopes[slopes[panel] == freq]
         title = None
         if not fitted.empty:
             title = f"slope over {fitted['cycles_from'].min()}-{fitted['cycles_to'].max()} cycles"
@@ -122,3 +128,27 @@ def frequency_name(freq: float) -> str:
         if abs(num - round(num)) < 1e-4:
             return f"{round(num)}/{den}" if den > 1 else f"{round(num)}"
     return f"{freq:g}"
+
+
+def axis_boxplots(
+    results: pd.DataFrame, design, out_dir: Path, n_cycles: int | None = None
+) -> dict[str, Path]:
+    """Write one box-plot figure per declared axis of ``design``
+    (`suds_exp.experiment.ExperimentDesign`): ``boxplot_<axis>.png``, ln RMS error of vx
+    by learner, one panel per pair category along the axis (same / near / far, same /
+    lower / higher, same / different). ``results`` must carry the ``<axis>_pair`` columns
+    (`suds_exp.analysis.design_tables.label_pairs`). Returns name -> path."""
+    rows, size = at_cycles(results, n_cycles)
+    models = learner_order(rows["model"])
+    width = max(4.0, 0.6 * len(models) + 1.5)
+    paths = {}
+    for axis in design.axes:
+        cats = axis.categories
+        fig = Figure(figsize=(len(cats) * width, 4.5), layout="constrained")
+        axes = np.atleast_1d(fig.subplots(1, len(cats), sharey=True))
+        for ax, cat in zip(axes, cats, strict=True):
+            _panel(ax, rows[rows[f"{axis.name}_pair"] == cat], models, f"{cat} {axis.name}")
+        axes[0].set_ylabel(YLABEL)
+        fig.suptitle(f"Prediction error by {axis.name} ({axis.kind}; {size} training cycles)")
+        paths[f"boxplot_{axis.name}"] = _save(fig, out_dir / f"boxplot_{axis.name}.png")
+    return paths

@@ -15,6 +15,7 @@ import pandas as pd
 
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
+from suds_exp.analysis.design_report import write_design_report
 from suds_exp.analysis.findings import (
     PASSIVE_EXPLANATION,
     campaign_passive_information,
@@ -29,6 +30,7 @@ from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr,
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
 from suds_exp.errors import AnalysisError
+from suds_exp.experiment import ExperimentDesign, is_paper
 from suds_exp.store import Store
 from suds_exp.store.files import check_writable
 
@@ -142,6 +144,7 @@ def write_report(
     n_cycles: int | None = None,
     upper_from: int | None = None,
     pairs: str = "same-condition",
+    design: ExperimentDesign | None = None,
 ) -> Path:
     """Write the report of ``campaign`` into ``out_dir`` (default ``reports/<campaign>``).
 
@@ -165,6 +168,9 @@ def write_report(
         First training size of the slope fits (default the median size).
     pairs : {"same-condition", "same-frequency"}
         Train/test pairs of the spread table and sample-efficiency figure (see `iqr_table`).
+    design : ExperimentDesign, optional
+        The experiment's axes (`suds_exp.experiment`); None or the paper's: this report.
+        Another design writes `suds_exp.analysis.design_report.write_design_report`.
 
     Returns
     -------
@@ -178,6 +184,8 @@ def write_report(
         out_dir = Path("reports") / campaign
     out = Path(out_dir)
     check_writable(out, "out: report folder", AnalysisError, param="out")
+    if not is_paper(design):
+        return write_design_report(store, campaign, design, out, n_cycles)
     results = load_results(store, campaign)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)

@@ -87,11 +87,22 @@ def slope_table(
     fewer than two training sizes are in the range.
     """
     rows = _pooled(results, pairs)
+    return _ordered(fit_slopes(rows, ["frequency_hz", "model"], upper_from, pairs))
+
+
+def fit_slopes(
+    rows: pd.DataFrame,
+    keys: list[str],
+    upper_from: int | None = None,
+    pairs: str = "same-condition",
+) -> pd.DataFrame:
+    """The log-log slopes of `slope_table` on ``rows`` (labelled results of the ``pairs``
+    named in errors), one per group of ``keys``; columns ``keys``, then as `slope_table`'s."""
     sizes = np.sort(rows["n_cycles"].unique())
     start = int(np.median(sizes)) if upper_from is None else int(upper_from)
     rows = rows[rows["n_cycles"] >= start]
     out = []
-    for (freq, model), g in rows.groupby(["frequency_hz", "model"]):
+    for group, g in rows.groupby(keys):
         x = np.log(g["n_cycles"].to_numpy(dtype=float))
         y = g["ln_rmse_vx"].to_numpy(dtype=float)
         slope = lo = hi = np.nan
@@ -106,8 +117,7 @@ def slope_table(
                 lo, hi = slope - half, slope + half
         out.append(
             {
-                "frequency_hz": freq,
-                "model": model,
+                **dict(zip(keys, group, strict=True)),
                 "slope": slope,
                 "ci_low": lo,
                 "ci_high": hi,
@@ -118,4 +128,4 @@ def slope_table(
         )
     if not out:
         raise AnalysisError(f"no {pairs} results with n_cycles >= {start}")
-    return _ordered(pd.DataFrame(out))
+    return pd.DataFrame(out)

@@ -55,9 +55,11 @@ def select_conditions(spec: str | None, available: list[Condition], option: str)
             continue
         gait, _, hz = item.partition("@")
         gait = gait.strip()
-        if gait and gait not in GAITS:
+        # a user design's conditions are named by their labels (`suds_exp.experiment`)
+        known = dict.fromkeys((*GAITS, *(c[0] for c in pool)))
+        if gait and gait not in known:
             raise CampaignError(
-                f"{option}: gait {gait!r} in {item!r}; expected one of {' '.join(GAITS)}",
+                f"{option}: gait {gait!r} in {item!r}; expected one of {' '.join(known)}",
                 param=option,
             )
         f = _parse_hz(hz, option) if hz.strip() else None

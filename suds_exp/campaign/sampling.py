@@ -10,6 +10,11 @@ Given the draw's random generator (`Draw.seed`):
    excluded, in a random order; from each in turn a random contiguous range of as many
    cycles as still needed, until ``n_cycles`` are drawn. Usually the first trial is long
    enough, as in the paper ("a 30 cycle interval from that trial").
+
+Recordings without conditions (an experiment design with no axis but the frequency,
+`suds_exp.experiment`) have the one condition label ``all``; its draws are run by trial:
+draw ``b`` tests on the ``b``-th eligible trial (in trial order) instead of a random one,
+training on the others (leave-one-trial-out).
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.conditions import Condition, format_condition
 from suds_exp.campaign.grid import Draw
 from suds_exp.errors import CampaignError
+from suds_exp.experiment import BY_TRIAL_LABEL
 
 
 @dataclass(frozen=True)
@@ -49,7 +55,12 @@ def draw_sample(bank: SampleBank, draw: Draw, test_cycles: int) -> Sample:
     eligible = _eligible_tests(bank, draw.train, draw.test, draw.n_cycles)
     if not eligible:
         raise CampaignError(f"{format_condition(draw.test)}: no test trial available for {draw}")
-    ti = eligible[int(rng_test.integers(len(eligible)))]
+    if draw.train == draw.test and draw.test[0] == BY_TRIAL_LABEL:
+        # recordings without conditions: draw b tests on the b-th eligible trial, so
+        # `boots` = number of trials leaves each trial out once
+        ti = eligible[draw.boot % len(eligible)]
+    else:
+        ti = eligible[int(rng_test.integers(len(eligible)))]
     a, b = max(bank.runs[ti], key=lambda r: r[1] - r[0])
     m = min(test_cycles, b - a + 1)
     start = a + int(rng_test.integers(b - a + 2 - m))

@@ -8,8 +8,9 @@ from pathlib import Path
 import sqlalchemy as sa
 
 from suds_exp.errors import IngestError
+from suds_exp.experiment import ExperimentDesign
 from suds_exp.ingest.layout import check_layout, layout_json, read_layout
-from suds_exp.ingest.manifest import Condition, read_manifest
+from suds_exp.ingest.manifest import Condition, check_axes, read_manifest, store_condition
 from suds_exp.ingest.pose import PoseOptions
 from suds_exp.ingest.readers import READERS, read_capture
 from suds_exp.progress import progress_bar
@@ -63,6 +64,7 @@ def ingest_file(
     layout_source: str = "layout",
     conn: sa.Connection | None = None,
     pose: PoseOptions | None = None,
+    design: ExperimentDesign | None = None,
 ) -> IngestResult:
     """Read, validate and store one capture file in one transaction.
 
@@ -70,14 +72,15 @@ def ingest_file(
     writes nothing) for a bad file, a layout naming markers the file lacks, or a
     condition already taken by a different capture. ``conn``: a connection from
     ``store.writer()`` to reuse (the transaction is still this file's own). ``pose``: how
-    to read keypoint files (`suds_exp.ingest.pose.PoseOptions`).
+    to read keypoint files (`suds_exp.ingest.pose.PoseOptions`). ``design``: the
+    experiment whose axes ``condition`` carries values of (`read_manifest`).
     """
     capture, digest = read_capture(path, pose)
     if layout is not None:
         check_layout(layout, capture.marker_names, layout_source, path)
     if conn is None:
         with store.writer() as own:
-            return ingest_file(store, path, condition, layout, layout_source, own, pose)
+            return ingest_file(store, path, condition, layout, layout_source, own, pose, design)
     with conn.begin():
         existing = conn.execute(
             sa.select(trials.c.id).where(trials.c.content_hash == digest)
@@ -119,6 +122,8 @@ def ingest_file(
             .returning(trials.c.id)
         ).scalar_one()
         store.insert_df(conn, markers.name, capture.long_frame(trial_id))
+        if condition is not None and condition.axes and design is not None:
+            store_condition(conn, trial_id, condition, design)
     label = (
         f"{condition.gait} {condition.frequency_hz:g} Hz #{condition.repeat}"
         if condition
@@ -143,6 +148,7 @@ def ingest_paths(
     progress: bool = True,
     keep_going: bool = False,
     pose: PoseOptions | None = None,
+    design: ExperimentDesign | None = None,
 ) -> list[IngestResult]:
     """Ingest capture files and folders, each file in its own transaction.
 
@@ -169,10 +175,13 @@ def ingest_paths(
     pose : PoseOptions, optional
         How to read keypoint files (DeepLabCut, SLEAP, Lightning Pose, Anipose): tracker,
         frame rate, mm per pixel, confidence threshold (`suds_exp.ingest.pose`).
+    design : ExperimentDesign, optional
+        The experiment's condition axes (`suds_exp.experiment.load_design`); default the
+        paper's (gait, frequency_hz). The manifest's columns are checked against it.
     """
     if pose is not None:
         pose.check()
-    conditions = read_manifest(manifest) if manifest is not None else {}
+    conditions = read_manifest(manifest, design) if manifest is not None else {}
     roles = read_layout(layout) if layout is not None else None
     exclude = {Path(p).resolve() for p in (manifest, layout) if p is not None}
     files = expand_paths(list(paths), exclude) if paths else sorted(conditions)
@@ -185,10 +194,15 @@ def ingest_paths(
     enabled = progress and len(files) > 1
     bar = progress_bar("Ingesting", total=len(files), enabled=enabled, unit="files")
     with store.locked("ingest"), bar as advance, store.writer() as conn:
+        if design is not None and any(c.axes for c in conditions.values()):
+            with conn.begin():
+                check_axes(conn, design)
         for path in files:
             condition = conditions.get(Path(path).resolve())
             try:
-                results.append(ingest_file(store, path, condition, roles, source, conn, pose))
+                results.append(
+                    ingest_file(store, path, condition, roles, source, conn, pose, design)
+                )
             except IngestError as exc:
                 if not keep_going:
                     raise

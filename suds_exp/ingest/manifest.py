@@ -3,14 +3,23 @@
 Columns ``file,gait,frequency_hz,repeat,notes``; ``file`` is relative to the
 manifest's folder (or absolute); ``frequency_hz`` may be a decimal or a fraction
 (``1/3``); ``notes`` may be empty.
+
+With an experiment description (`suds_exp.experiment`, ``design=``) other than the
+paper's, the columns are ``file,frequency_hz,repeat,notes`` and one per declared axis
+(``gait`` is then whatever the design declares, or absent): a column the design does not
+declare is refused naming the file and column, and each cell is checked against its axis.
+The trial's ``gait`` is then its condition label (`ExperimentDesign.label`) and its axis
+values go to `trial_conditions` (migration 020).
 """
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from suds_exp.errors import IngestError
+from suds_exp.errors import ConfigError, IngestError
+from suds_exp.experiment import FREQUENCY_AXIS, Axis, ExperimentDesign, is_paper
 from suds_exp.ingest.tables_csv import read_text_table
 from suds_exp.robot import GAITS, parse_frequency
 
@@ -26,11 +35,16 @@ class Condition:
     frequency_hz: float
     repeat: int
     notes: str | None = None
+    #: (axis, value) of every declared axis of a user design; empty for the paper's
+    axes: tuple[tuple[str, str | float], ...] = ()
 
 
-def read_manifest(path: Path) -> dict[Path, Condition]:
-    """Resolved file path -> `Condition` for every row of the manifest at ``path``."""
+def read_manifest(path: Path, design: ExperimentDesign | None = None) -> dict[Path, Condition]:
+    """Resolved file path -> `Condition` for every row of the manifest at ``path``;
+    ``design``: the experiment's axes (None or the paper's: gait and frequency_hz)."""
     path = Path(path)
+    if not is_paper(design):
+        return _read_designed(path, design)
     table = read_text_table(path, "manifest", COLUMNS[:4])
     out: dict[Path, Condition] = {}
     for i, row in enumerate(table.itertuples(index=False), start=2):
@@ -60,3 +74,89 @@ def read_manifest(path: Path) -> dict[Path, Condition]:
         notes = getattr(row, "notes", "").strip() or None
         out[file] = Condition(gait, freq, repeat, notes)
     return out
+
+
+#: The gait's cycle frequency when the design does not declare it an axis.
+_CYCLE_RATE = Axis(FREQUENCY_AXIS, "numeric")
+
+
+def _read_designed(path: Path, design: ExperimentDesign) -> dict[Path, Condition]:
+    required = ("file", FREQUENCY_AXIS, "repeat", *design.names)
+    table = read_text_table(path, "manifest", tuple(dict.fromkeys(required)))
+    known = {*required, "notes"}
+    unknown = [c for c in table.columns if c not in known]
+    if unknown:
+        raise IngestError(
+            f"{path}: line 1: column {unknown[0]!r} is not an axis of the experiment "
+            f"({design.source}: {', '.join(design.names) or 'no axes'})",
+            param="experiment",
+        )
+    frequency = design.axis(FREQUENCY_AXIS) if FREQUENCY_AXIS in design.names else None
+    out: dict[Path, Condition] = {}
+    for i, row in enumerate(table.to_dict("records"), start=2):
+        where = f"{path}: line {i}"
+        file = (path.parent / row["file"].strip()).resolve()
+        if not file.is_file():
+            raise IngestError(f"{where}: file {row['file'].strip()!r} does not exist")
+        try:
+            values = {a.name: a.parse(row[a.name], where) for a in design.axes}
+            hz = (frequency or _CYCLE_RATE).parse(row[FREQUENCY_AXIS], where)
+        except ConfigError as exc:
+            raise IngestError(str(exc), param="manifest") from None
+        try:
+            repeat = int(row["repeat"].strip())
+        except ValueError:
+            raise IngestError(
+                f"{where}: repeat {row['repeat']!r}: expected a whole number"
+            ) from None
+        if file in out:
+            raise IngestError(f"{where}: file {row['file'].strip()!r} is listed twice")
+        notes = row.get("notes", "").strip() or None
+        out[file] = Condition(design.label(values), hz, repeat, notes, tuple(values.items()))
+    return out
+
+
+def check_axes(conn, design: ExperimentDesign) -> None:
+    """Refuse a design whose axes differ from those already stored (`experiment_axes`),
+    naming the axis; reads only."""
+    stored = {
+        r[0]: (r[1], r[2])
+        for r in conn.exec_driver_sql("SELECT axis, kind, levels FROM experiment_axes")
+    }
+    for a in design.axes:
+        if a.name in stored and stored[a.name] != (a.kind, _levels_json(a)):
+            kind, levels = stored[a.name]
+            raise IngestError(
+                f"{design.source}: axis {a.name!r} is declared {a.kind} {list(a.levels)} but "
+                f"the database has it {kind} {levels or ''}; use the same declaration",
+                param="experiment",
+            )
+
+
+def store_condition(conn, trial_id: int, condition: Condition, design: ExperimentDesign) -> None:
+    """Write the design's axes (those not stored yet) and the trial's values along them,
+    in the caller's transaction."""
+    if not condition.axes:
+        return
+    have = {r[0] for r in conn.exec_driver_sql("SELECT axis FROM experiment_axes")}
+    for a in design.axes:
+        if a.name in have:
+            continue
+        conn.exec_driver_sql(
+            "INSERT INTO experiment_axes SELECT ?, count(*), ?, ? FROM experiment_axes",
+            (a.name, a.kind, _levels_json(a)),
+        )
+        for i, level in enumerate(a.levels):
+            conn.exec_driver_sql(
+                "INSERT INTO experiment_levels VALUES (?, ?, ?)", (a.name, level, i)
+            )
+    for name, value in condition.axes:
+        number = float(value) if isinstance(value, float) else None
+        text = f"{value:g}" if number is not None else str(value)
+        conn.exec_driver_sql(
+            "INSERT INTO trial_conditions VALUES (?, ?, ?, ?)", (trial_id, name, text, number)
+        )
+
+
+def _levels_json(axis: Axis) -> str | None:
+    return json.dumps(list(axis.levels)) if axis.levels else None
