@@ -176,14 +176,7 @@ def write_report(
     -------
     Path of ``index.html``.
     """
-    if out_dir is None:
-        if not _SAFE_NAME.match(campaign):
-            raise AnalysisError(
-                f"campaign {campaign!r} is not a safe folder name; pass out DIR", param="out"
-            )
-        out_dir = Path("reports") / campaign
-    out = Path(out_dir)
-    check_writable(out, "out: report folder", AnalysisError, param="out")
+    out = _report_folder(campaign, out_dir)
     if not is_paper(design):
         return write_design_report(store, campaign, design, out, n_cycles)
     results = load_results(store, campaign)
@@ -197,18 +190,7 @@ def write_report(
             tables["iqr"], tables["slopes"], out / "sample_efficiency.png"
         )
 
-    files: dict[str, dict[str, Path]] = {}
-    digits = {"compare_iqr": 2, "iqr": 3, "slopes": 3, "agreement": 2}
-    for name, frame in tables.items():
-        md = to_markdown(findings_display(frame)) if name == "findings" else None
-        if name == "iqr":
-            md = "".join(
-                f"### IQR of RMS error of vx (mm/s) at {plots.frequency_name(f)} Hz\n\n"
-                f"{to_markdown(w)}\n"
-                for f, w in iqr_wide(frame).items()
-            )
-        files[name] = write_table(frame, out, name, digits.get(name, 2), md)
-
+    files = _write_tables(tables, out)
     page = _page(campaign, store, results, size, tables, figures, files, pairs)
     passive = campaign_passive_information(store, campaign)
     passive_files = (
@@ -226,6 +208,37 @@ def write_report(
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")
     return index
+
+
+def _report_folder(campaign: str, out_dir: str | Path | None) -> Path:
+    """``out_dir``, or ``reports/<campaign>`` when the name is a safe folder name; checked
+    writable before anything is computed."""
+    if out_dir is None:
+        if not _SAFE_NAME.match(campaign):
+            raise AnalysisError(
+                f"campaign {campaign!r} is not a safe folder name; pass out DIR", param="out"
+            )
+        out_dir = Path("reports") / campaign
+    out = Path(out_dir)
+    check_writable(out, "out: report folder", AnalysisError, param="out")
+    return out
+
+
+def _write_tables(tables: dict[str, pd.DataFrame], out: Path) -> dict[str, dict[str, Path]]:
+    """Each report table as CSV and Markdown in ``out`` (the IQR table one Markdown
+    table per frequency); returns each table's files by name."""
+    files: dict[str, dict[str, Path]] = {}
+    digits = {"compare_iqr": 2, "iqr": 3, "slopes": 3, "agreement": 2}
+    for name, frame in tables.items():
+        md = to_markdown(findings_display(frame)) if name == "findings" else None
+        if name == "iqr":
+            md = "".join(
+                f"### IQR of RMS error of vx (mm/s) at {plots.frequency_name(f)} Hz\n\n"
+                f"{to_markdown(w)}\n"
+                for f, w in iqr_wide(frame).items()
+            )
+        files[name] = write_table(frame, out, name, digits.get(name, 2), md)
+    return files
 
 
 _FINDINGS_SLOT = "<!-- findings -->"

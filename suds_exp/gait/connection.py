@@ -142,17 +142,7 @@ def learned_connection(
         uniform = np.column_stack([np.cos(b), np.sin(b)])
         dirs = [uniform] * len(pts)
     else:
-        moving = norm > 1e-6
-        shapes = samples[["ra_1", "ra_2"]].to_numpy(float)[moving]
-        unit = rate[moving] / norm[moving, None]
-        tree = cKDTree(shapes)
-        rng = np.random.default_rng(seed)
-        dirs = []
-        for p, ok in zip(pts, inside.ravel(), strict=True):
-            idx = np.asarray(tree.query_ball_point(p, radius), dtype=int) if ok else []
-            if len(idx) > MAX_VISITED:
-                idx = rng.choice(idx, MAX_VISITED, replace=False)
-            dirs.append(unit[idx] if len(idx) else np.empty((0, 2)))
+        dirs = _visited_directions(samples, rate, norm, pts, inside.ravel(), radius, seed)
     counts = np.array([len(d) for d in dirs])
     ra = np.repeat(pts, counts, axis=0)
     every = np.concatenate(dirs)
@@ -191,6 +181,24 @@ def learned_connection(
     curl[~inside] = np.nan
     spread[~inside] = np.nan
     return LearnedConnection(axis, axis, A, inside, nonlin, curl, spread)
+
+
+def _visited_directions(samples, rate, norm, pts, inside, radius, seed) -> list[np.ndarray]:
+    """For each grid shape in ``pts`` (n, 2) inside the support, the unit shape velocities
+    (m, 2) of the training samples within ``radius`` rad of it (at most `MAX_VISITED`,
+    drawn with ``seed``); an empty (0, 2) array outside."""
+    moving = norm > 1e-6
+    shapes = samples[["ra_1", "ra_2"]].to_numpy(float)[moving]
+    unit = rate[moving] / norm[moving, None]
+    tree = cKDTree(shapes)
+    rng = np.random.default_rng(seed)
+    dirs = []
+    for p, ok in zip(pts, inside, strict=True):
+        idx = np.asarray(tree.query_ball_point(p, radius), dtype=int) if ok else []
+        if len(idx) > MAX_VISITED:
+            idx = rng.choice(idx, MAX_VISITED, replace=False)
+        dirs.append(unit[idx] if len(idx) else np.empty((0, 2)))
+    return dirs
 
 
 def compare_connections(

@@ -280,29 +280,18 @@ def design_gait(
         distance = support.gait_distance(gait)
         summary = support.summary() | {"n_trials": int(samples["trial_id"].nunique())}
         achieved, trial_id = None, None
+        used = trust
         if opts.verify:
             trial_id = _verify_trial(store, version, gait, opts, out, design_id, it, config)
             achieved = simulate_gaits([gait], opts.frequency_hz, config)[0]
-            error = abs(predicted.forward_mm - achieved.forward_mm) / max(
-                abs(achieved.forward_mm), 1e-9
+            factor, best_achieved = _verified_factor(
+                opts, fitted, predicted, achieved, best, best_achieved, config
             )
-            used = trust
-            if opts.radius_rule == "ratio":
-                if not np.isfinite(best_achieved):
-                    best_achieved = simulate_gaits([best], opts.frequency_hz, config)[0].forward_mm
-                factor = _ratio_factor(
-                    achieved.forward_mm - best_achieved,
-                    predicted.forward_mm - fitted.forward(best, opts.frequency_hz),
-                    opts,
-                )
-            else:
-                factor = _radius_factor(error, opts)
             trust = min(opts.trust_max, trust * factor)
             if achieved.forward_mm > best_achieved:
                 best, best_achieved = gait, achieved.forward_mm
             samples = version.samples()
         else:
-            used = trust
             trust = min(opts.trust_max, trust * opts.grow)
             best = gait
         record = Iteration(
@@ -321,6 +310,25 @@ def design_gait(
         if progress is not None:
             progress(record)
     return design
+
+
+def _verified_factor(opts, fitted, predicted, achieved, best, best_achieved, config):
+    """The trust radius' factor after a verified iteration, and the best forward
+    displacement achieved before it (mm; the start gait is simulated once, when the
+    ratio rule first needs it)."""
+    if opts.radius_rule != "ratio":
+        error = abs(predicted.forward_mm - achieved.forward_mm) / max(
+            abs(achieved.forward_mm), 1e-9
+        )
+        return _radius_factor(error, opts), best_achieved
+    if not np.isfinite(best_achieved):
+        best_achieved = simulate_gaits([best], opts.frequency_hz, config)[0].forward_mm
+    factor = _ratio_factor(
+        achieved.forward_mm - best_achieved,
+        predicted.forward_mm - fitted.forward(best, opts.frequency_hz),
+        opts,
+    )
+    return factor, best_achieved
 
 
 def _ratio_factor(real_gain: float, predicted_gain: float, opts: DesignOptions) -> float:

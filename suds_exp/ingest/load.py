@@ -94,15 +94,7 @@ def ingest_file(
                 f"{path}: already ingested as trial {existing} (same content); nothing done",
             )
         if condition is not None:
-            clash = conn.execute(
-                sa.select(trials.c.id, trials.c.source_file).where(_same_condition(condition))
-            ).first()
-            if clash is not None:
-                raise IngestError(
-                    f"{path}: condition gait={condition.gait} frequency_hz="
-                    f"{condition.frequency_hz:g} repeat={condition.repeat} is already trial "
-                    f"{clash.id} ({clash.source_file}) with different content"
-                )
+            _check_condition_free(conn, path, condition)
         trial_id = conn.execute(
             sa.insert(trials)
             .values(
@@ -138,6 +130,19 @@ def ingest_file(
         f"{path}: trial {trial_id}, {capture.n_frames} frames, "
         f"{len(capture.marker_names)} markers ({label}){notes}",
     )
+
+
+def _check_condition_free(conn: sa.Connection, path: Path, condition: Condition) -> None:
+    """Refuse ``path`` when its condition (gait, frequency, repeat) is already a trial."""
+    clash = conn.execute(
+        sa.select(trials.c.id, trials.c.source_file).where(_same_condition(condition))
+    ).first()
+    if clash is not None:
+        raise IngestError(
+            f"{path}: condition gait={condition.gait} frequency_hz="
+            f"{condition.frequency_hz:g} repeat={condition.repeat} is already trial "
+            f"{clash.id} ({clash.source_file}) with different content"
+        )
 
 
 def ingest_paths(
