@@ -48,7 +48,7 @@ from statistics import median
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from learner_speed import _export  # noqa: E402  (git archive of the baseline)
+from learner_speed import alternate  # noqa: E402  (baseline export and working tree in turn)
 
 
 def worker(boots: int, sweep: list[int]) -> dict:
@@ -179,12 +179,7 @@ def main(argv=None) -> int:
     if a.worker:
         print(json.dumps(worker(a.boots, sweep)))
         return 0
-    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
-        _export(a.baseline, Path(tmp))
-        base, now = [], []
-        for _ in range(a.rounds):
-            base.append(_run(Path(tmp), a))
-            now.append(_run(ROOT, a))
+    base, now = alternate(a.baseline, a.rounds, lambda path: _run(path, a))
     n = base[0]["jobs"]
     print(
         f"## Campaign CPU per job, small grid ({n} jobs: {a.boots} draw(s), sweep {a.sweep}), "

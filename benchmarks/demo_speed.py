@@ -30,14 +30,16 @@ import json
 import os
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
-from io import BytesIO
 from pathlib import Path
 from statistics import median
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from learner_speed import _export  # noqa: E402  (git archive of the baseline)
+
 STEPS = ("simulate", "discrepancy")
 
 
@@ -79,14 +81,6 @@ def worker(step: str) -> dict:
         "threads": numba.get_num_threads(),
         "suds_exp": suds_exp.__file__,
     }
-
-
-def _export(commit: str, folder: Path) -> None:
-    data = subprocess.run(
-        ["git", "archive", commit, "suds_exp"], cwd=ROOT, check=True, capture_output=True
-    ).stdout
-    with tarfile.open(fileobj=BytesIO(data)) as tar:
-        tar.extractall(folder, filter="data")
 
 
 def _run(path: Path, *args: str) -> str:

@@ -102,6 +102,18 @@ def worker(cycles: int, repeats: int, n_jobs: int, models: str | None = None) ->
     return out
 
 
+def alternate(commit: str, rounds: int, run) -> tuple[list, list]:
+    """``run(path)`` on an export of ``commit`` and on the working tree, in turn, ``rounds``
+    times (so load changes hit both sides); returns the baseline's and the tree's results."""
+    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
+        _export(commit, Path(tmp))
+        base, now = [], []
+        for _ in range(rounds):
+            base.append(run(Path(tmp)))
+            now.append(run(ROOT))
+    return base, now
+
+
 def _export(commit: str, folder: Path) -> None:
     data = subprocess.run(
         ["git", "archive", commit, "suds_exp"], cwd=ROOT, check=True, capture_output=True
@@ -132,12 +144,7 @@ def main(argv=None) -> int:
     if a.worker:
         print(json.dumps(worker(a.cycles, a.repeats, a.jobs, a.models)))
         return 0
-    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
-        _export(a.baseline, Path(tmp))
-        base, now = [], []
-        for _ in range(a.rounds):
-            base.append(_run(Path(tmp), a))
-            now.append(_run(ROOT, a))
+    base, now = alternate(a.baseline, a.rounds, lambda path: _run(path, a))
     print(
         f"## Learner CPU seconds per job (fit + predict), {a.cycles} training cycles, "
         f"{a.jobs} draws x {a.repeats} repeats a worker, {a.rounds} rounds; "

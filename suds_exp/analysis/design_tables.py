@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.analysis.categories import at_cycles, learner_order
-from suds_exp.analysis.glm import RESPONSES, fit_formula
+from suds_exp.analysis.glm import RESPONSES, fit_formula, formulas
 from suds_exp.analysis.spread import fit_slopes
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import ExperimentDesign, classify_pair, pair_column
@@ -130,11 +130,7 @@ def design_formulas(
         ref = REFERENCE[axis.kind] if REFERENCE[axis.kind] in present else present[0]
         refs[axis.name] = ref
         terms.append(f"C({col}, Treatment(reference='{ref}'))")
-    if not terms:
-        raise AnalysisError("GLM: every predictor is constant in these results; nothing to fit")
-    direct = "y ~ " + " + ".join(terms)
-    interactions = direct if len(terms) == 1 else f"y ~ ({' + '.join(terms)})**2"
-    return direct, interactions, refs
+    return (*formulas(terms), refs)
 
 
 def design_term_name(column: str) -> str:

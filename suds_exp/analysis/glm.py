@@ -95,11 +95,17 @@ def glm_formulas(frame: pd.DataFrame) -> tuple[str, str, dict[str, str]]:
             terms.append(f"C({name}, Treatment(reference='{ref}'))")
         else:
             terms.append(name)
+    return (*formulas(terms), refs)
+
+
+def formulas(terms: list[str]) -> tuple[str, str]:
+    """The formula of the main effects of ``terms`` (patsy terms) and the one with their
+    two-way interactions (the same when there is one term)."""
     if not terms:
         raise AnalysisError("GLM: every predictor is constant in these results; nothing to fit")
     direct = "y ~ " + " + ".join(terms)
     interactions = direct if len(terms) == 1 else f"y ~ ({' + '.join(terms)})**2"
-    return direct, interactions, refs
+    return direct, interactions
 
 
 def term_name(column: str) -> str:
