@@ -40,7 +40,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 #: The survey's recipe before session 15 ("old"), every setting a candidate changes
@@ -159,29 +158,25 @@ def load_samples(db: str, gaits: list[str], spec: str):
 
 
 def tolerance(rows: pd.DataFrame, learner: str) -> pd.DataFrame:
-    """Per size: M_old, the per-seed medians' SD, tol = 2 SD, and the mean per-draw range."""
-    cur = rows[(rows["learner"] == learner) & (rows["recipe"] == "old")]
-    per_seed = cur.groupby(["n_cycles", "seed"])["rmse_vx"].median().unstack("seed")
-    per_draw = cur.groupby(["n_cycles", "train_frequency_hz", "boot"])["rmse_vx"]
-    return pd.DataFrame(
-        {
-            "median": cur.groupby("n_cycles")["rmse_vx"].median(),
-            "seed_sd": per_seed.std(axis=1, ddof=1),
-            "tol": 2 * per_seed.std(axis=1, ddof=1),
-            "draw_range": (per_draw.max() - per_draw.min()).groupby("n_cycles").median(),
-            "seeds": per_seed.notna().sum(axis=1),
-        }
-    )
+    """`seed_tolerance` of the old recipe, and the median per-draw range over seeds."""
+    from suds_exp.analysis.survey import seed_tolerance
+
+    old = rows[(rows["learner"] == learner) & (rows["recipe"] == "old")]
+    per_draw = old.groupby(["n_cycles", "train_frequency_hz", "boot"])["rmse_vx"]
+    draw_range = (per_draw.max() - per_draw.min()).groupby("n_cycles").median()
+    return seed_tolerance(old).assign(draw_range=draw_range)
 
 
 def judge(rows: pd.DataFrame, learner: str, tol: pd.DataFrame) -> pd.DataFrame:
-    """One row per recipe: median rmse_vx difference to current per size, accepted, CPU."""
+    """One row per recipe: median rmse_vx minus the old recipe's per size, whether every
+    size is within tol, CPU seconds of a 30-cycle job (median) and the speed-up."""
+    from suds_exp.analysis.survey import within_seed_tolerance
+
     out = []
     mine = rows[rows["learner"] == learner]
-    cur_cpu = mine[(mine["recipe"] == "old") & (mine["n_cycles"] == 30)]["cpu_s"].median()
+    old_cpu = mine[(mine["recipe"] == "old") & (mine["n_cycles"] == 30)]["cpu_s"].median()
     for label, r in mine.groupby("recipe", sort=False):
-        diff = r.groupby("n_cycles")["rmse_vx"].median() - tol["median"]
-        ok = bool((diff.abs() <= tol["tol"] + 1e-12).all()) and diff.notna().all()
+        diff, ok = within_seed_tolerance(r, tol)
         cpu30 = r[r["n_cycles"] == 30]["cpu_s"].median()
         out.append(
             {
@@ -190,7 +185,7 @@ def judge(rows: pd.DataFrame, learner: str, tol: pd.DataFrame) -> pd.DataFrame:
                 "worst/tol": float((diff.abs() / tol["tol"]).max()),
                 "within": ok,
                 "cpu30": cpu30,
-                "speed-up": cur_cpu / cpu30,
+                "speed-up": old_cpu / cpu30,
                 "seeds": r["seed"].nunique(),
             }
         )
@@ -268,15 +263,17 @@ def main(argv=None) -> int:
                 print(f"done {t[0]} {t[1]} seed {t[3]}: {new['cpu_s'].sum():.1f} CPU s", flush=True)
     errors = rows[rows["error"].notna()]
     if len(errors):
-        print(f"{len(errors)} failed jobs:", errors[["learner", "recipe", "error"]].drop_duplicates())
+        failed = errors[["learner", "recipe", "error"]].drop_duplicates()
+        print(f"{len(errors)} failed jobs:\n{failed.to_string(index=False)}")
     with pd.option_context("display.width", 250, "display.max_columns", 40):
         for learner in LEARNERS:
             if learner not in set(rows["learner"]):
                 continue
             tol = tolerance(rows, learner)
             print(f"\n## {learner}: old recipe, rmse_vx (mm/s) per size")
-            print(tol.round(4).to_string())
-            print(f"\n{learner}: recipes, median rmse_vx - old's per size; within = every |d| <= tol")
+            # 3 significant digits: KRR's spread is ~1e-7 mm/s
+            print(tol.to_string(float_format=lambda v: f"{v:.3g}"))
+            print(f"\n{learner}: median rmse_vx - the old recipe's per size; within: |d| <= tol")
             print(judge(rows, learner, tol).round(4).to_string(index=False))
         if {"MLP", "GMR"} <= set(rows["learner"]):
             print("\n## MLP / GMR data ratio at GMR's 30-cycle error (seed 0, 95 % bootstrap)")
