@@ -37,8 +37,9 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
 
 import pandas as pd  # noqa: E402
 
@@ -144,8 +145,9 @@ def _task(learner: str, label: str, params: dict, seed: int) -> list[dict]:
 
 
 def load_samples(db: str, gaits: list[str], spec: str):
-    import survey as sv
-
+    """The default dataset's ``gaits`` (simulated into ``db`` if empty), decimated as a
+    per-condition survey does it, and the conditions of ``spec``."""
+    from benchmarks import survey as sv
     from suds_exp.campaign.bank import rounded_conditions
     from suds_exp.campaign.conditions import select_conditions
     from suds_exp.store import Store
