@@ -421,3 +421,52 @@ def test_learner_glm_recovers_each_learners_excess_error_and_its_loss_off_gait()
     same = pd.DataFrame(rows).query("gait_sim == 'same' and period_rel == '='")
     with pytest.raises(Exception, match="cross pairs"):
         learner_glm(same, 30)
+
+
+def seeded_rows(shift: float = 0.0, sizes=(1, 2), seeds=3) -> pd.DataFrame:
+    """Per size, seed s and draw d: 3 + shift + 0.1 s + (d - 1); the per-seed medians are
+    3 + shift + 0.1 s (sd 0.1 over three seeds), the median over all is 3.1 + shift."""
+    return pd.DataFrame(
+        [
+            {"n_cycles": n, "seed": s, "boot": d, "rmse_vx": 3 + shift + 0.1 * s + (d - 1)}
+            for n in sizes
+            for s in range(seeds)
+            for d in range(3)
+        ]
+    )
+
+
+def test_a_recipe_is_within_the_seed_tolerance_only_at_every_size():
+    from suds_exp.analysis.survey import seed_tolerance, within_seed_tolerance
+
+    tol = seed_tolerance(seeded_rows())
+    np.testing.assert_allclose(tol["median"], 3.1)
+    np.testing.assert_allclose(tol["seed_sd"], 0.1)
+    np.testing.assert_allclose(tol["tol"], 0.2)
+    diff, ok = within_seed_tolerance(seeded_rows(0.15), tol)
+    np.testing.assert_allclose(diff, 0.15)
+    assert ok
+    assert not within_seed_tolerance(seeded_rows(-0.25), tol)[1]
+    one_size_off = pd.concat([seeded_rows(0.0, (1,)), seeded_rows(0.25, (2,))])
+    assert not within_seed_tolerance(one_size_off, tol)[1]
+    assert not within_seed_tolerance(seeded_rows(0.0, (1,)), tol)[1]  # a size missing
+
+
+def test_the_seed_tolerance_needs_two_seeds():
+    from suds_exp.analysis.survey import seed_tolerance
+    from suds_exp.errors import AnalysisError
+
+    with pytest.raises(AnalysisError, match="two seeds"):
+        seed_tolerance(seeded_rows(seeds=1))
+
+
+def test_the_baselines_defaults_are_the_recipe_judged_in_the_speed_results():
+    # docs/results/speed.md, "Session 15": every faster setting tried was outside the
+    # baselines' own seed-to-seed spread, so the defaults stay the old recipe; a change of
+    # default must be judged again with benchmarks/survey_tolerance.py.
+    from benchmarks.survey_tolerance import OLD_RECIPES, base_of
+
+    for name in ("MLP", "MLP+SUDS", "GBT", "KRR"):
+        params = make_model(name).estimator.get_params()
+        for key, value in OLD_RECIPES[base_of(name)].items():
+            assert params[key] == (tuple(value) if isinstance(value, list) else value), key

@@ -17,6 +17,10 @@ sweep (same-condition pairs at several training sizes):
   size). Above 1: the learner needs that many times GMR's data. A learner that never
   reaches the target within the sweep gives inf.
 - `timing_table`: median fit and predict seconds per learner and training size.
+- `seed_tolerance`, `within_seed_tolerance`: a learner's own randomness at each training
+  size (the spread over seeds of the survey's statistic, the median error over draws),
+  and whether another recipe of it stays within that spread: the rule by which a faster
+  setting of a survey baseline may replace the old one (`benchmarks/survey_tolerance.py`).
 - `learner_glm`: generalisation across frequency and gait with the learner as a factor:
   100 ln(RMS error of vx) on learner (reference GMR), period relation and gait
   similarity (the paper's references), and the learner x similarity interactions, on the
@@ -268,6 +272,44 @@ def learner_glm(
 def _short_term(term: str) -> str:
     """``C(learner, Treatment(reference='GMR'))[T.MLP]`` -> ``learner[MLP]``."""
     return re.sub(r"C\((\w+), Treatment\(reference='[^']*'\)\)\[T\.([^\]]+)\]", r"\1[\2]", term)
+
+
+def seed_tolerance(rows: pd.DataFrame, metric: str = "rmse_vx", k: float = 2.0) -> pd.DataFrame:
+    """A recipe's own randomness per training size.
+
+    ``rows``: one learner, one recipe, the same draws fitted with several seeds; columns
+    ``n_cycles``, ``seed`` and ``metric`` (mm/s for rmse_vx). m_s(n) is the median of
+    ``metric`` over the draws of size n with seed s (the survey's statistic with one seed).
+
+    Returns a frame indexed by ``n_cycles``: ``median`` (over draws and seeds), ``seed_sd``
+    (standard deviation of m_s(n) over the seeds, ddof 1), ``tol`` (= k x seed_sd) and
+    ``seeds`` (how many). AnalysisError with fewer than two seeds at a size.
+    """
+    per_seed = rows.groupby(["n_cycles", "seed"])[metric].median().unstack("seed")
+    seeds = per_seed.notna().sum(axis=1)
+    if len(per_seed) == 0 or int(seeds.min()) < 2:
+        raise AnalysisError("seed tolerance: needs at least two seeds at every training size")
+    sd = per_seed.std(axis=1, ddof=1)
+    return pd.DataFrame(
+        {
+            "median": rows.groupby("n_cycles")[metric].median(),
+            "seed_sd": sd,
+            "tol": k * sd,
+            "seeds": seeds,
+        }
+    )
+
+
+def within_seed_tolerance(
+    candidate: pd.DataFrame, tolerance: pd.DataFrame, metric: str = "rmse_vx"
+) -> tuple[pd.Series, bool]:
+    """(median of ``metric`` over draws and seeds minus the reference's, per size; whether
+    every size is within ``tolerance["tol"]``). ``tolerance`` is `seed_tolerance` of the
+    reference recipe; a size the candidate lacks counts as outside."""
+    diff = candidate.groupby("n_cycles")[metric].median().reindex(tolerance.index)
+    diff = diff - tolerance["median"]
+    ok = bool(diff.notna().all() and (diff.abs() <= tolerance["tol"]).all())
+    return diff, ok
 
 
 SURVEY_COLUMNS = KEY_COLUMNS + (
