@@ -44,7 +44,9 @@ archive`) and of this working tree, each in its own process, alternating (A B A 
 the overhead over the learners' own time in the same run (small grid, as above), split
 into the fixed cost of a run, the batch writes and the rest per job, and the overhead
 at paper scale: (fixed cost + per-job cost x 21,000 jobs) / (learners' time per job x
-21,000 jobs), the per-job figures measured on the small grid.
+21,000 jobs), the per-job figures measured on the small grid. With ``--paper-boots N``
+the measured campaign is the paper's grid itself (15 x 15 pairs and the sweep on the
+synthetic data's 15 conditions) with N draws a cell (2,100 jobs for N = 1), one a process.
 """
 
 from __future__ import annotations
@@ -151,19 +153,25 @@ def _cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def campaign_seconds(samples, folder, jobs, cpu: dict | None = None) -> tuple[float, float]:
-    """(wall s, s spent in the learners' fit + predict as recorded in `results`); fills
-    ``cpu`` with the CPU seconds of the parent and of each worker during the run."""
+def campaign_seconds(
+    samples, folder, jobs, cpu: dict | None = None, options: CampaignOptions | None = None
+) -> tuple[float, float]:
+    """(wall s, s spent in the learners' fit + predict as recorded in `results`) of the
+    campaign of ``options`` (default: the small grid); fills ``cpu`` with the CPU seconds
+    of the parent and of each worker during the run."""
     store = fresh_store(folder, f"j{jobs}")
     before = worker_usage() if cpu is not None and jobs > 1 else {}
     c0, t0 = _cpu(), time.perf_counter()
-    s = run_campaign(store, "bench", small_options(), samples=samples, jobs=jobs, progress=False)
+    s = run_campaign(
+        store, "bench", options or small_options(), samples=samples, jobs=jobs, progress=False
+    )
     elapsed = time.perf_counter() - t0
     if cpu is not None:
         cpu["parent"] = _cpu() - c0
         after = worker_usage() if jobs > 1 else {}
         cpu["workers"] = [after[p][0] - before.get(p, (0.0, 0))[0] for p in after]
-    assert s.done_now == s.total_jobs == 16 * BOOTS * len(LEARNERS) and s.failed_now == 0, s
+    expected = s.total_jobs if options else 16 * BOOTS * len(LEARNERS)
+    assert s.done_now == s.total_jobs == expected and s.failed_now == 0, s
     learners = store.query_df("SELECT sum(fit_seconds + predict_seconds) AS s FROM results").s[0]
     if cpu is not None:
         # the same call with every job done: the per-run cost (lock, definition, bank,
@@ -172,6 +180,7 @@ def campaign_seconds(samples, folder, jobs, cpu: dict | None = None) -> tuple[fl
         run_campaign(store, "bench", samples=samples, jobs=jobs, progress=False)
         cpu["fixed_s"] = time.perf_counter() - t1
         cpu["writes_s"] = s.flush_seconds
+        cpu["jobs"] = s.done_now
     return elapsed, float(learners)
 
 
@@ -257,18 +266,27 @@ def paper_scale(learner_s_per_job: float, fixed_s: float, overhead_s_per_job: fl
     return (fixed_s + overhead_s_per_job * n) / (learner_s_per_job * n)
 
 
-def overhead_rounds(samples, folder, rounds: int) -> list[dict]:
-    """``rounds`` in-process runs of the small campaign, after a warm-up one: for each, the
-    wall s, the learners' own s, the batch writes' s and the fixed cost of a run."""
+def paper_options(boots: int) -> CampaignOptions:
+    """The paper's grid (every condition as train and test, the paper's sweep) with
+    ``boots`` draws a cell instead of 10."""
+    return CampaignOptions(
+        models=list(LEARNERS), boots=boots, train_cycles=CYCLES, sweep=list(PAPER_SWEEP)
+    )
+
+
+def overhead_rounds(samples, folder, rounds: int, paper_boots: int = 0) -> list[dict]:
+    """``rounds`` in-process runs of the small campaign (or, given ``paper_boots``, of
+    `paper_options`), after a warm-up one of the small grid: for each, the wall s, the
+    learners' own s, the batch writes' s and the fixed cost of a run."""
     campaign_seconds(samples, folder, 1)
+    options = paper_options(paper_boots) if paper_boots else None
     out = []
     for _ in range(rounds):
         cpu: dict = {}
-        wall, learners = campaign_seconds(samples, folder, 1, cpu)
-        n = 16 * BOOTS * len(LEARNERS)
+        wall, learners = campaign_seconds(samples, folder, 1, cpu, options)
         out.append(
             {
-                "jobs": n,
+                "jobs": cpu["jobs"],
                 "wall_s": wall,
                 "learners_s": learners,
                 "fixed_s": cpu["fixed_s"],
@@ -292,13 +310,14 @@ def overhead_figures(r: dict) -> dict:
     }
 
 
-def compare_with_baseline(baseline: str, rounds: int, per_process: int) -> None:
+def compare_with_baseline(baseline: str, rounds: int, per_process: int, paper_boots: int) -> None:
     """Print the overhead of ``baseline`` (a folder or a commit) and of this tree."""
     from learner_speed import alternate
 
     def run(path: Path) -> list[dict]:
         env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
         cmd = [sys.executable, __file__, "--overhead-worker", str(per_process)]
+        cmd += ["--paper-boots", str(paper_boots)]
         res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
         return json.loads(res.stdout.splitlines()[-1])
 
@@ -312,11 +331,16 @@ def compare_with_baseline(baseline: str, rounds: int, per_process: int) -> None:
         base, now = alternate(baseline, rounds, run)
     fb = [overhead_figures(r) for rs in base for r in rs]
     fn = [overhead_figures(r) for rs in now for r in rs]
-    print(
-        f"## Framework overhead, small grid ({base[0][0]['jobs']} jobs, {CYCLES} cycles, "
-        f"in-process), {rounds} rounds x {per_process} runs a side; baseline {baseline}, "
-        "now = working tree"
+    grid = (
+        f"the paper's grid with {paper_boots} draw(s) a cell (sweep included)"
+        if paper_boots
+        else f"small grid ({CYCLES} cycles)"
     )
+    print(
+        f"## Framework overhead, {grid}: {base[0][0]['jobs']} jobs, in-process, "
+        f"{rounds} rounds x {per_process} runs a side; baseline {baseline}, now = working tree"
+    )
+    print(f"baseline from {base[0][0]['suds_exp']}, now from {now[0][0]['suds_exp']}")
     print(f"load average before {load}, after {os.getloadavg()}")
     print("| figure (median) | baseline | now |")
     print("|---|---|---|")
@@ -428,15 +452,25 @@ def main(argv=None):
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--baseline", help="compare the overhead with this folder or commit")
     ap.add_argument("--rounds", type=int, default=5, help="with --baseline: processes a side")
+    ap.add_argument(
+        "--paper-boots",
+        type=int,
+        default=0,
+        help="with --baseline: measure on the paper's grid with this many draws a cell",
+    )
     ap.add_argument("--overhead-worker", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.baseline:
-        compare_with_baseline(args.baseline, args.rounds, per_process=2)
+        per_process = 1 if args.paper_boots else 2
+        compare_with_baseline(args.baseline, args.rounds, per_process, args.paper_boots)
         return
     folder = Path(tempfile.mkdtemp(prefix="suds_bench_campaign_"))
     if args.overhead_worker:
-        rounds = overhead_rounds(paper_like_samples(), folder, args.overhead_worker)
-        print(json.dumps(rounds))
+        import suds_exp
+
+        samples = paper_like_samples()
+        rounds = overhead_rounds(samples, folder, args.overhead_worker, args.paper_boots)
+        print(json.dumps([r | {"suds_exp": suds_exp.__file__} for r in rounds]))
         return
     t0 = time.perf_counter()
     samples = paper_like_samples()
