@@ -4,6 +4,7 @@ finished jobs, projected paper-scale time and peak memory.
 Usage::
 
     .venv/bin/python benchmarks/campaign.py [--repeats 3] [--no-projection] [--json]
+    .venv/bin/python benchmarks/campaign.py --baseline /tmp/base [--rounds 5]
 
 Data: the models' synthetic swimmer (`suds_exp.testing.synthetic_swimmer.make_samples`), 5 gaits
 x 3 frequencies x 4 trials x 25 cycles captured at 100 Hz, so after decimation every
@@ -12,11 +13,12 @@ cycle has 100 samples as in the paper's data. Figures:
 - overhead: wall time of `run_campaign` (in-process, fresh database: definition, sample
   bank, sampling, frames, database writes) over the time of the same jobs' make_model +
   fit + predict in a bare loop on frames built beforehand; 4 conditions, 16 pairs x 3 draws,
-  all five learners, 30 training cycles as in the paper. Target <= 5 %.
+  all five learners, 30 training cycles as in the paper. Target (issue 32): <= 3 % at
+  paper scale, where the fixed cost of a run is paid once for 21,000 jobs.
 - overhead is given two ways: over the learners' own fit + predict time recorded in the
   same run (immune to load changes between runs), and over a separate bare loop.
 - speed-up: the same campaign on 2 loky workers vs in-process (workers warmed up first).
-  Target >= 1.8x. The machine is shared, so beside it: how many cores this workload got
+  Target >= 1.9x. The machine is shared, so beside it: how many cores this workload got
   from two processes at the time (2 x time of one bare loop alone / time of two bare loops
   run at once in two processes, no campaign code involved),
   and the speed-up the CPU times imply for two idle cores: CPU time of the in-process run
@@ -34,6 +36,17 @@ cycle has 100 samples as in the paper's data. Figures:
   Target <= 2 GiB each.
 
 Medians over ``--repeats`` runs, interleaved so that load changes hit both sides.
+
+``--baseline PATH_OR_COMMIT``: instead, the framework overhead only, of a baseline (a
+checkout's folder, e.g. a `git worktree add` of main, or a commit exported with `git
+archive`) and of this working tree, each in its own process, alternating (A B A B ...)
+``--rounds`` times with two measured campaigns a process after a warm-up one. Per side:
+the overhead over the learners' own time in the same run (small grid, as above), split
+into the fixed cost of a run, the batch writes and the rest per job, and the overhead
+at paper scale: (fixed cost + per-job cost x 21,000 jobs) / (learners' time per job x
+21,000 jobs), the per-job figures measured on the small grid. With ``--paper-boots N``
+the measured campaign is the paper's grid itself (15 x 15 pairs and the sweep on the
+synthetic data's 15 conditions) with N draws a cell (2,100 jobs for N = 1), one a process.
 """
 
 from __future__ import annotations
@@ -43,6 +56,7 @@ import json
 import os
 import resource
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -54,7 +68,10 @@ import pandas as pd
 from joblib import parallel_config
 from threadpoolctl import threadpool_limits
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+ROOT = Path(__file__).resolve().parents[1]
+# this tree's suds_exp, unless PYTHONPATH names the checkout to measure (--baseline runs)
+if not os.environ.get("PYTHONPATH"):
+    sys.path.insert(0, str(ROOT))
 
 from suds_exp.campaign import CampaignOptions, SampleBank, enumerate_draws, run_campaign  # noqa: E402
 from suds_exp.campaign.bank import rounded_conditions  # noqa: E402
@@ -136,19 +153,25 @@ def _cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def campaign_seconds(samples, folder, jobs, cpu: dict | None = None) -> tuple[float, float]:
-    """(wall s, s spent in the learners' fit + predict as recorded in `results`); fills
-    ``cpu`` with the CPU seconds of the parent and of each worker during the run."""
+def campaign_seconds(
+    samples, folder, jobs, cpu: dict | None = None, options: CampaignOptions | None = None
+) -> tuple[float, float]:
+    """(wall s, s spent in the learners' fit + predict as recorded in `results`) of the
+    campaign of ``options`` (default: the small grid); fills ``cpu`` with the CPU seconds
+    of the parent and of each worker during the run."""
     store = fresh_store(folder, f"j{jobs}")
     before = worker_usage() if cpu is not None and jobs > 1 else {}
     c0, t0 = _cpu(), time.perf_counter()
-    s = run_campaign(store, "bench", small_options(), samples=samples, jobs=jobs, progress=False)
+    s = run_campaign(
+        store, "bench", options or small_options(), samples=samples, jobs=jobs, progress=False
+    )
     elapsed = time.perf_counter() - t0
     if cpu is not None:
         cpu["parent"] = _cpu() - c0
         after = worker_usage() if jobs > 1 else {}
         cpu["workers"] = [after[p][0] - before.get(p, (0.0, 0))[0] for p in after]
-    assert s.done_now == s.total_jobs == 16 * BOOTS * len(LEARNERS) and s.failed_now == 0, s
+    expected = s.total_jobs if options else 16 * BOOTS * len(LEARNERS)
+    assert s.done_now == s.total_jobs == expected and s.failed_now == 0, s
     learners = store.query_df("SELECT sum(fit_seconds + predict_seconds) AS s FROM results").s[0]
     if cpu is not None:
         # the same call with every job done: the per-run cost (lock, definition, bank,
@@ -156,6 +179,8 @@ def campaign_seconds(samples, folder, jobs, cpu: dict | None = None) -> tuple[fl
         t1 = time.perf_counter()
         run_campaign(store, "bench", samples=samples, jobs=jobs, progress=False)
         cpu["fixed_s"] = time.perf_counter() - t1
+        cpu["writes_s"] = s.flush_seconds
+        cpu["jobs"] = s.done_now
     return elapsed, float(learners)
 
 
@@ -214,6 +239,10 @@ def overhead_and_speedup(samples, folder, repeats):
         * statistics.median(w * f / (1 + f) for w, f in zip(one, inside, strict=True))
         / n,
         "fixed_cost_per_run_s": statistics.median(fixed),
+        "paper_scale_overhead": statistics.median(
+            paper_scale(w / (1 + f) / n, fx, pj)
+            for w, f, fx, pj in zip(one, inside, fixed, per_job, strict=True)
+        ),
         "overhead_ms_per_job_beyond_fixed": 1000 * statistics.median(per_job),
         "mean_learner_ms_per_job": 1000
         * statistics.median(w / (1 + f) for w, f in zip(one, inside, strict=True))
@@ -222,6 +251,102 @@ def overhead_and_speedup(samples, folder, repeats):
         "machine_capacity_cores": statistics.median(capacity),
         "speedup_from_cpu_times": statistics.median(cpu_speedup),
     }
+
+
+def paper_jobs() -> int:
+    """Jobs of the paper campaign: 15 x 15 pairs x 10 draws, and the same-condition sweep
+    (15 conditions x 10 draws x 13 sizes besides 30), five learners each."""
+    return 5 * 225 * 10 + 5 * 15 * 10 * (len(PAPER_SWEEP) - 1)
+
+
+def paper_scale(learner_s_per_job: float, fixed_s: float, overhead_s_per_job: float) -> float:
+    """Framework overhead over the learners' own time of a campaign of `paper_jobs` jobs
+    that pays ``fixed_s`` once and ``overhead_s_per_job`` for each job."""
+    n = paper_jobs()
+    return (fixed_s + overhead_s_per_job * n) / (learner_s_per_job * n)
+
+
+def paper_options(boots: int) -> CampaignOptions:
+    """The paper's grid (every condition as train and test, the paper's sweep) with
+    ``boots`` draws a cell instead of 10."""
+    return CampaignOptions(
+        models=list(LEARNERS), boots=boots, train_cycles=CYCLES, sweep=list(PAPER_SWEEP)
+    )
+
+
+def overhead_rounds(samples, folder, rounds: int, paper_boots: int = 0) -> list[dict]:
+    """``rounds`` in-process runs of the small campaign (or, given ``paper_boots``, of
+    `paper_options`), after a warm-up one of the small grid: for each, the wall s, the
+    learners' own s, the batch writes' s and the fixed cost of a run."""
+    campaign_seconds(samples, folder, 1)
+    options = paper_options(paper_boots) if paper_boots else None
+    out = []
+    for _ in range(rounds):
+        cpu: dict = {}
+        wall, learners = campaign_seconds(samples, folder, 1, cpu, options)
+        out.append(
+            {
+                "jobs": cpu["jobs"],
+                "wall_s": wall,
+                "learners_s": learners,
+                "fixed_s": cpu["fixed_s"],
+                "writes_s": cpu["writes_s"],
+            }
+        )
+    return out
+
+
+def overhead_figures(r: dict) -> dict:
+    """One round's overhead figures (see the module docstring)."""
+    n = r["jobs"]
+    per_job = (r["wall_s"] - r["learners_s"] - r["fixed_s"]) / n
+    return {
+        "overhead %": 100 * (r["wall_s"] / r["learners_s"] - 1),
+        "fixed s per run": r["fixed_s"],
+        "writes ms per job": 1000 * r["writes_s"] / n,
+        "rest ms per job": 1000 * (per_job - r["writes_s"] / n),
+        "learners ms per job": 1000 * r["learners_s"] / n,
+        "paper-scale overhead %": 100 * paper_scale(r["learners_s"] / n, r["fixed_s"], per_job),
+    }
+
+
+def compare_with_baseline(baseline: str, rounds: int, per_process: int, paper_boots: int) -> None:
+    """Print the overhead of ``baseline`` (a folder or a commit) and of this tree."""
+    from learner_speed import alternate
+
+    def run(path: Path) -> list[dict]:
+        env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
+        cmd = [sys.executable, __file__, "--overhead-worker", str(per_process)]
+        cmd += ["--paper-boots", str(paper_boots)]
+        res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
+        return json.loads(res.stdout.splitlines()[-1])
+
+    load = os.getloadavg()
+    if Path(baseline).is_dir():
+        base, now = [], []
+        for _ in range(rounds):
+            base.append(run(Path(baseline)))
+            now.append(run(ROOT))
+    else:
+        base, now = alternate(baseline, rounds, run)
+    fb = [overhead_figures(r) for rs in base for r in rs]
+    fn = [overhead_figures(r) for rs in now for r in rs]
+    grid = (
+        f"the paper's grid with {paper_boots} draw(s) a cell (sweep included)"
+        if paper_boots
+        else f"small grid ({CYCLES} cycles)"
+    )
+    print(
+        f"## Framework overhead, {grid}: {base[0][0]['jobs']} jobs, in-process, "
+        f"{rounds} rounds x {per_process} runs a side; baseline {baseline}, now = working tree"
+    )
+    print(f"baseline from {base[0][0]['suds_exp']}, now from {now[0][0]['suds_exp']}")
+    print(f"load average before {load}, after {os.getloadavg()}")
+    print("| figure (median) | baseline | now |")
+    print("|---|---|---|")
+    for key in fb[0]:
+        b, m = statistics.median(f[key] for f in fb), statistics.median(f[key] for f in fn)
+        print(f"| {key} | {b:.3f} | {m:.3f} |")
 
 
 def resume_seconds(samples, folder, repeats):
@@ -294,7 +419,7 @@ def projection(samples, folder):
         "slice_jobs": s.done_now,
         "slice_wall_s": wall,
         "slice_parallel_throughput": throughput,
-        "paper_jobs": 5 * 225 * 10 + 5 * 15 * 10 * (len(PAPER_SWEEP) - 1),
+        "paper_jobs": paper_jobs(),
         "paper_cpu_s": main + sweep,
         "paper_projected_wall_s": (main + sweep) / throughput,
         "mean_fit_predict_s_at_30_cycles": per_model_30,
@@ -325,8 +450,28 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--no-projection", action="store_true")
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--baseline", help="compare the overhead with this folder or commit")
+    ap.add_argument("--rounds", type=int, default=5, help="with --baseline: processes a side")
+    ap.add_argument(
+        "--paper-boots",
+        type=int,
+        default=0,
+        help="with --baseline: measure on the paper's grid with this many draws a cell",
+    )
+    ap.add_argument("--overhead-worker", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.baseline:
+        per_process = 1 if args.paper_boots else 2
+        compare_with_baseline(args.baseline, args.rounds, per_process, args.paper_boots)
+        return
     folder = Path(tempfile.mkdtemp(prefix="suds_bench_campaign_"))
+    if args.overhead_worker:
+        import suds_exp
+
+        samples = paper_like_samples()
+        rounds = overhead_rounds(samples, folder, args.overhead_worker, args.paper_boots)
+        print(json.dumps([r | {"suds_exp": suds_exp.__file__} for r in rounds]))
+        return
     t0 = time.perf_counter()
     samples = paper_like_samples()
     out = {"samples_rows": len(samples), "samples_seconds": time.perf_counter() - t0}
@@ -357,16 +502,18 @@ def main(argv=None):
         f"same run ({o['overhead_ms_per_job']:.1f} ms/job), "
         f"{100 * o['overhead_vs_bare_loop']:.1f} % over a separate bare loop "
         f"(bare {o['bare_loop_s']:.2f} s, campaign "
-        f"{o['campaign_1_worker_s']:.2f} s); target <= 5 %"
+        f"{o['campaign_1_worker_s']:.2f} s)"
     )
     print(
         f"  of which fixed per run {o['fixed_cost_per_run_s']:.2f} s and "
         f"{o['overhead_ms_per_job_beyond_fixed']:.2f} ms per job "
-        f"(learners {o['mean_learner_ms_per_job']:.1f} ms per job here)"
+        f"(learners {o['mean_learner_ms_per_job']:.1f} ms per job here); at paper scale "
+        f"({paper_jobs()} jobs, the fixed cost paid once): "
+        f"{100 * o['paper_scale_overhead']:.1f} %; target <= 3 %"
     )
     print(
         f"speed-up 2 workers over 1: {o['speedup_2_over_1']:.2f}x "
-        f"({o['campaign_1_worker_s']:.2f} s -> {o['campaign_2_workers_s']:.2f} s; target >= 1.8x);"
+        f"({o['campaign_1_worker_s']:.2f} s -> {o['campaign_2_workers_s']:.2f} s; target >= 1.9x);"
         f" two bare loops in two processes got {o['machine_capacity_cores']:.2f} cores meanwhile;"
         f" from CPU times (idle 2 cores): {o['speedup_from_cpu_times']:.2f}x"
     )

@@ -1,0 +1,120 @@
+"""A worker's pieces: sample frames from the bank, learners checked once, the prediction
+read for the RMS error, and a run stopped inside a chunk of draws (library API, SQL)."""
+
+from __future__ import annotations
+
+import dataclasses
+import signal
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from suds_exp.campaign import CampaignOptions, SampleBank, job, run_campaign
+from suds_exp.campaign.job import new_model, predicted_velocity
+from suds_exp.errors import ConfigError
+from suds_exp.models import make_model
+from suds_exp.robot import VB_COLUMNS
+from suds_exp.store import Store
+from tests.test_campaign_grid import synthetic_samples
+from tests.test_campaign_runner import results
+
+
+@pytest.fixture(scope="module")
+def bank() -> SampleBank:
+    return SampleBank.build(synthetic_samples(conditions=(("O", 0.5), ("O", 1.0))))
+
+
+def frame_by_column(bank: SampleBank, pieces: list[np.ndarray]) -> pd.DataFrame:
+    """The samples frame of ``pieces`` built one array per column."""
+    data = np.concatenate(pieces)
+    columns = {c: data[:, j] for j, c in enumerate(bank.columns)}
+    for c in ("trial_id", "frame", "cycle"):
+        columns[c] = columns[c].astype(np.int64)
+    return pd.DataFrame(columns)
+
+
+def test_a_sample_frame_holds_the_bank_rows_of_its_cycles(bank):
+    (a, _), (c, _) = bank.runs[0][0], bank.runs[1][0]
+    pieces = [bank.rows(0, a, a + 1), bank.rows(1, c, c)]
+    frame = bank.frame(pieces)
+    pd.testing.assert_frame_equal(frame, frame_by_column(bank, pieces), check_exact=True)
+    assert set(frame.cycle[: len(pieces[0])]) == {a, a + 1}
+    assert set(frame.cycle[len(pieces[0]) :]) == {c}
+    # a learner's shallow copy may gain or overwrite columns: the next learner sees none
+    copy = frame.copy(deep=False)
+    copy["extra"] = 1.0
+    copy["vx"] = 0.0
+    pd.testing.assert_frame_equal(frame, frame_by_column(bank, pieces), check_exact=True)
+
+
+def test_rows_of_a_trial_whose_cycles_do_not_ascend_are_found_too(bank):
+    a, _ = bank.runs[0][0]
+    col = bank.columns.index("cycle")
+    lo, hi = bank.row_start[0], bank.row_stop[0]
+    values = bank.values.copy()
+    values[lo:hi] = values[lo:hi][::-1]  # the trial's rows in reverse time order
+    reversed_bank = dataclasses.replace(bank, values=values)
+    block = values[lo:hi]
+    expected = block[(block[:, col] >= a) & (block[:, col] <= a + 1)]
+    assert len(expected) > 0
+    np.testing.assert_array_equal(reversed_bank.rows(0, a, a + 1), expected)
+    np.testing.assert_array_equal(bank.rows(0, a, a + 1), expected[::-1])
+
+
+def _prediction_frames():
+    rng = np.random.default_rng(0)
+    v = rng.standard_normal((50, 5))
+    plain = pd.DataFrame(v, columns=["vx", "vy", "wz", "drp_1", "drp_2"])
+    shuffled = plain[["drp_2", "wz", "vx", "drp_1", "vy"]]
+    labelled = plain.assign(label="a", vy=np.arange(50))  # a str and an int column
+    doubled = pd.DataFrame(v, columns=["vx", "vy", "wz", "x", "x"])
+    return [plain, shuffled, labelled, doubled]
+
+
+@pytest.mark.parametrize("pred", _prediction_frames())
+def test_the_predicted_velocity_is_read_by_column_name(pred):
+    expected = np.column_stack([pred[c].to_numpy(dtype=float) for c in VB_COLUMNS])
+    got = predicted_velocity(pred)
+    np.testing.assert_array_equal(got, expected)
+    assert got.dtype == np.float64 and got.flags.c_contiguous
+
+
+def test_a_prediction_without_a_velocity_column_fails_naming_it():
+    with pytest.raises(KeyError, match="wz"):
+        predicted_velocity(pd.DataFrame({"vx": [1.0], "vy": [2.0]}))
+
+
+def test_a_learner_is_checked_once_then_built_like_make_model():
+    first = new_model("TLS", {"ridge": 1e-6})
+    again = new_model("TLS", {"ridge": 1e-3})
+    assert again is not first and again.get_params() == make_model("TLS", ridge=1e-3).get_params()
+    with pytest.raises(ConfigError, match="unknown parameter"):
+        new_model("TLS", {"ridge": 1e-6, "nonsense": 1})
+
+
+def test_a_run_stopped_inside_a_chunk_resumes_with_every_row_once(tmp_path, monkeypatch):
+    samples = synthetic_samples(conditions=(("O", 0.5), ("D+", 1.0)))
+    options = CampaignOptions(models=["phase-only", "TLS"], boots=2, train_cycles=3, sweep=[1])
+    full = Store(tmp_path / "full.duckdb")
+    run_campaign(full, "c", options, samples=samples, progress=False)
+
+    draws = 0
+    make_draw = job.draw_sample
+
+    def ctrl_c_at_the_fifth_draw(*args):
+        nonlocal draws
+        draws += 1
+        if draws == 5:  # the second draw of the second chunk (three draws a chunk)
+            signal.raise_signal(signal.SIGINT)
+        return make_draw(*args)
+
+    monkeypatch.setattr(job, "draw_sample", ctrl_c_at_the_fifth_draw)
+    store = Store(tmp_path / "x.duckdb")
+    stopped = run_campaign(store, "c", options, samples=samples, chunk_jobs=6, progress=False)
+    assert stopped.interrupted and stopped.done_now == 6  # the first chunk's rows only
+    monkeypatch.undo()
+
+    again = run_campaign(store, "c", samples=samples, progress=False)
+    assert again.done_before == 6 and again.done_now == again.total_jobs - 6
+    pd.testing.assert_frame_equal(results(store), results(full), check_exact=True)
