@@ -9,12 +9,22 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test test-slow browser lint lint-imports docs wheel-check clean
 
+# The dependencies go in with uv (itself installed from PyPI by pip), some 20x faster than
+# pip (docs/results/speed.md, session 15); pip installs them when uv cannot be had. uv reads
+# no pip configuration: a private index is given to it as UV_INDEX_URL / UV_EXTRA_INDEX_URL.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(INSTALL) -e '.[dev]'
 	$(BIN)/python -m suds_exp.sim.precompile
 	touch $(STAMP)
+
+# `$(INSTALL) ARGS`: uv's `pip install ARGS` into the venv, else pip's
+INSTALL = install() { \
+	  { test -x $(BIN)/uv || $(BIN)/python -m pip install --quiet uv; } \
+	  && $(BIN)/uv pip install --quiet --python $(BIN)/python "$$@" \
+	  || { echo "uv unavailable: installing with pip"; \
+	       $(BIN)/python -m pip install --quiet --upgrade pip \
+	       && $(BIN)/python -m pip install --quiet "$$@"; }; }; install
 
 demo: $(STAMP)
 	$(BIN)/suds-exp demo
@@ -43,7 +53,7 @@ lint-imports: $(STAMP)
 # The documentation site (mkdocs.yml) into site/, warnings as errors; needs the docs extra.
 DOCS_STAMP := $(VENV)/.docs-installed
 $(DOCS_STAMP): $(STAMP)
-	$(BIN)/python -m pip install --quiet -e '.[dev,docs]'
+	$(INSTALL) -e '.[dev,docs]'
 	touch $(DOCS_STAMP)
 
 docs: $(DOCS_STAMP)
