@@ -29,9 +29,10 @@ INSTALL = install() { \
 demo: $(STAMP)
 	$(BIN)/suds-exp demo
 
-# two worker processes, each test file on one of them (its module fixtures built once)
+# two worker processes, each test file on one of them (its module fixtures built once);
+# files in collection order (tests/conftest.py puts the slowest first), not by test count
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n 2 --dist loadfile
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder
 
 # The slow suite screenshots the report with a headless browser; Debian's chromium is
 # installed here (never in `make test`) when apt-get is usable, else that test skips.
