@@ -9,19 +9,36 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test test-slow browser lint lint-imports docs wheel-check clean
 
+# The dependencies go in with uv (itself installed from PyPI by pip), some 20x faster than
+# pip (docs/results/speed.md, session 15); pip installs them when uv cannot be had. uv reads
+# no pip configuration: a private index is given to it as UV_INDEX_URL / UV_EXTRA_INDEX_URL.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
-	$(BIN)/python -m suds_exp.sim.precompile
+	$(INSTALL) -e '.[dev]'
+	$(PRECOMPILE)
 	touch $(STAMP)
+
+# uv writes no bytecode: compile it (as pip does; a failure is not fatal there either) while
+# numba compiles the simulator's kernels, one core each. Without it, every first import
+# compiles, and a loky worker killed mid-import outlives its parent (test_reliability.py).
+PRECOMPILE = { $(BIN)/python -m compileall -q -j 0 $(VENV)/lib >/dev/null 2>&1 || true; } & \
+	pyc=$$!; $(BIN)/python -m suds_exp.sim.precompile; rc=$$?; wait $$pyc; exit $$rc
+
+# `$(INSTALL) ARGS`: uv's `pip install ARGS` into the venv, else pip's
+INSTALL = install() { \
+	  { test -x $(BIN)/uv || $(BIN)/python -m pip install --quiet uv; } \
+	  && $(BIN)/uv pip install --quiet --python $(BIN)/python "$$@" \
+	  || { echo "uv unavailable: installing with pip"; \
+	       $(BIN)/python -m pip install --quiet --upgrade pip \
+	       && $(BIN)/python -m pip install --quiet "$$@"; }; }; install
 
 demo: $(STAMP)
 	$(BIN)/suds-exp demo
 
-# two worker processes, each test file on one of them (its module fixtures built once)
+# two worker processes, each test file on one of them (its module fixtures built once);
+# files in collection order (tests/conftest.py puts the slowest first), not by test count
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -n 2 --dist loadfile
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile --no-loadscope-reorder
 
 # The slow suite screenshots the report with a headless browser; Debian's chromium is
 # installed here (never in `make test`) when apt-get is usable, else that test skips.
@@ -43,7 +60,7 @@ lint-imports: $(STAMP)
 # The documentation site (mkdocs.yml) into site/, warnings as errors; needs the docs extra.
 DOCS_STAMP := $(VENV)/.docs-installed
 $(DOCS_STAMP): $(STAMP)
-	$(BIN)/python -m pip install --quiet -e '.[dev,docs]'
+	$(INSTALL) -e '.[dev,docs]'
 	touch $(DOCS_STAMP)
 
 docs: $(DOCS_STAMP)

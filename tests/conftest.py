@@ -15,6 +15,36 @@ import pytest
 SHARED = Path(os.environ.get("SUDS_SHARED") or Path(__file__).resolve().parents[2] / "shared")
 
 
+# The default run's slowest files (`pytest --durations`, docs/results/speed.md session 15),
+# slowest first. `make test` hands whole files to its 2 workers in collection order
+# (`--dist loadfile`): starting these first keeps one of them from being the last thing a
+# worker runs while the other waits.
+SLOW_FILES = (
+    "test_discrepancy_workflow.py",
+    "test_campaign_kill.py",
+    "test_gait_design.py",
+    "test_reliability.py",
+    "test_ingest_cli.py",
+    "test_docs.py",
+    "test_experiment_design.py",
+    "test_campaign_parallel.py",
+    "test_preprocess_reduction.py",
+    "test_campaign_skip.py",
+    "test_body_segments.py",
+    "test_preprocess_versions.py",
+    "test_campaign_runner.py",
+    "test_models_api.py",
+    "test_stream.py",
+)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run the `SLOW_FILES` first, in that order; every other file after them in its usual
+    order, and each file's tests in theirs."""
+    rank = {name: i for i, name in enumerate(SLOW_FILES)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
+
+
 @pytest.fixture
 def shared() -> Path:
     """The project's ../shared folder; skips the test when it is absent."""

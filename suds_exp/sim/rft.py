@@ -1008,8 +1008,10 @@ def run_trials(
     body = (el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side)
     out = (pose, vel, ang_out, phi_out, resid, iters, n_cont)
     for k in prange(phi.shape[0]):
+        # k as int64: prange's index is unsigned, and numba compiled _run_trial (and what it
+        # calls with k) once for each integer type, about 1 s of every fresh install
         _run_trial(
-            k, phi, n_steps[k], pose0[k], ang0[k], prm[k], el_w, body, dt, bed[k],
+            np.int64(k), phi, n_steps[k], pose0[k], ang0[k], prm[k], el_w, body, dt, bed[k],
             bed_scale[k], grains[k], out,
         )  # fmt: skip
 
