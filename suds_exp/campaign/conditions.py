@@ -19,9 +19,15 @@ def round_hz(frequency_hz: float) -> float:
     return round(float(frequency_hz), 6)
 
 
-def condition_sort_key(cond: Condition) -> tuple[int, float]:
+def condition_sort_key(cond: Condition) -> tuple[int, str, float]:
+    """The paper's gaits in their order (S+ S- O D- D+), then other gait labels
+    alphabetically; frequency last. Total on distinct conditions: the conditions come out
+    of sets, whose order changes with PYTHONHASHSEED, and a resumed campaign's plan must
+    equal the stored one."""
     gait, f = cond
-    return (GAITS.index(gait) if gait in GAITS else len(GAITS), f)
+    if gait in GAITS:
+        return (GAITS.index(gait), "", f)
+    return (len(GAITS), gait, f)
 
 
 def format_condition(cond: Condition) -> str:
