@@ -9,9 +9,10 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test test-slow browser lint lint-imports docs wheel-check clean
 
-# The dependencies go in with uv (itself installed from PyPI by pip), some 20x faster than
-# pip (docs/results/speed.md, session 15); pip installs them when uv cannot be had. uv reads
-# no pip configuration: a private index is given to it as UV_INDEX_URL / UV_EXTRA_INDEX_URL.
+# The dependencies go in with uv (itself installed from PyPI by pip), 7x (cold cache) to
+# 20x faster than pip (docs/results/speed.md, session 15); pip installs them when uv cannot
+# be had. uv reads no pip configuration: a private index is given to it as UV_INDEX_URL /
+# UV_EXTRA_INDEX_URL.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(INSTALL) -e '.[dev]'

@@ -28,7 +28,9 @@ def test_conditions_of_samples_do_not_depend_on_the_hash_seed():
         f"print(rounded_conditions(pd.DataFrame({_frame_dict()!r})))"
     )
     seen = set()
-    for seed in ("1", "2", "3", "4", "5", "6"):
+    # two processes suffice: before the fix, eight labels came out of the set in the same
+    # order under two seeds with odds of about 1 in 40,000 (8!)
+    for seed in ("1", "2"):
         env = {**os.environ, "PYTHONHASHSEED": seed}
         out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
         assert out.returncode == 0, out.stderr
