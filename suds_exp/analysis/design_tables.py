@@ -10,13 +10,11 @@ categories, and the IQR and sample-efficiency tables grouped by the test conditi
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pandas as pd
 
 from suds_exp.analysis.categories import at_cycles, learner_order
-from suds_exp.analysis.glm import RESPONSES, fit_formula, formulas
+from suds_exp.analysis.glm import RESPONSES, fit_formula, formulas, term_parts
 from suds_exp.analysis.spread import fit_slopes
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import ExperimentDesign, classify_pair, pair_column
@@ -24,7 +22,6 @@ from suds_exp.experiment import ExperimentDesign, classify_pair, pair_column
 #: The reference category of each axis kind in the GLM: a pair that differs by the least,
 #: as the paper's reference (near gait, trained at the lower frequency).
 REFERENCE = {"ordered": "near", "numeric": "lower", "unordered": "different"}
-_PART = re.compile(r"^C\((\w+), Treatment\(reference='[^']*'\)\)\[T\.(.+)\]$")
 
 
 def label_pairs(results: pd.DataFrame, design: ExperimentDesign) -> pd.DataFrame:
@@ -137,14 +134,12 @@ def design_term_name(column: str) -> str:
     """A design column's name: ``SUDS``, ``GMR``, ``gait=same``, joined by ``:``."""
     if column == "Intercept":
         return column
-    parts = []
-    for piece in column.split(":"):
-        m = _PART.match(piece)
-        if m:
-            parts.append(f"{m.group(1).removesuffix('_pair')}={m.group(2)}")
-        else:
-            parts.append({"suds": "SUDS", "gmr": "GMR"}.get(piece, piece))
-    return ":".join(parts)
+    return ":".join(
+        {"suds": "SUDS", "gmr": "GMR"}.get(factor, factor)
+        if level is None
+        else f"{factor.removesuffix('_pair')}={level}"
+        for factor, level, _ in term_parts(column)
+    )
 
 
 def design_glm_table(

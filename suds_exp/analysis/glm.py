@@ -108,15 +108,26 @@ def formulas(terms: list[str]) -> tuple[str, str]:
     return direct, interactions
 
 
+def term_parts(column: str) -> list[tuple[str, str | None, str]]:
+    """The factors of a patsy design column (not ``Intercept``), in its order, as
+    ``(factor, level, piece)``: ``level`` of a treatment-coded factor
+    (``C(f, Treatment(...))[T.level]``), None for a plain 0/1 column such as ``suds``;
+    ``piece`` the column's text for that factor."""
+    parts: list[tuple[str, str | None, str]] = []
+    for piece in column.split(":"):
+        m = _PART.match(piece)
+        parts.append((m.group(1), m.group(2), piece) if m else (piece, None, piece))
+    return parts
+
+
 def term_name(column: str) -> str:
     """The paper's name of a design column, e.g. ``SUDS:(model-period<data-period)``."""
     if column == "Intercept":
         return column
     parts = []
-    for piece in column.split(":"):
-        m = _PART.match(piece)
-        key = (m.group(1), m.group(2)) if m else piece
-        parts.append((_FACTOR_ORDER.index(key[0] if m else piece), LEVEL_NAMES.get(key, piece)))
+    for factor, level, piece in term_parts(column):
+        key = factor if level is None else (factor, level)
+        parts.append((_FACTOR_ORDER.index(factor), LEVEL_NAMES.get(key, piece)))
     parts.sort()
     if len(parts) == 1:
         return parts[0][1]
