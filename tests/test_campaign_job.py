@@ -11,9 +11,9 @@ import pandas as pd
 import pytest
 
 from suds_exp.campaign import CampaignOptions, SampleBank, job, run_campaign
-from suds_exp.campaign.job import new_model, predicted_velocity
+from suds_exp.campaign.job import predicted_velocity
 from suds_exp.errors import ConfigError
-from suds_exp.models import make_model
+from suds_exp.models import TLS, make_model
 from suds_exp.robot import VB_COLUMNS
 from suds_exp.store import Store
 from tests.test_campaign_grid import synthetic_samples
@@ -86,11 +86,11 @@ def test_a_prediction_without_a_velocity_column_fails_naming_it():
 
 
 def test_a_learner_is_checked_once_then_built_like_make_model():
-    first = new_model("TLS", {"ridge": 1e-6})
-    again = new_model("TLS", {"ridge": 1e-3})
-    assert again is not first and again.get_params() == make_model("TLS", ridge=1e-3).get_params()
+    first = make_model("TLS", ridge=1e-6)
+    again = make_model("TLS", ridge=1e-3)
+    assert again is not first and again.get_params() == TLS(ridge=1e-3).get_params()
     with pytest.raises(ConfigError, match="unknown parameter"):
-        new_model("TLS", {"ridge": 1e-6, "nonsense": 1})
+        make_model("TLS", ridge=1e-6, nonsense=1)
 
 
 def test_a_run_stopped_inside_a_chunk_resumes_with_every_row_once(tmp_path, monkeypatch):

@@ -114,6 +114,8 @@ def run_draw(
     bank: SampleBank, draw: Draw, names: list[str], models: dict[str, dict], test_cycles: int
 ) -> list[dict]:
     """Fit and test each learner in ``names`` on the draw's cycles; one row per learner."""
+    from suds_exp.models import make_model
+
     sample = draw_sample(bank, draw, test_cycles)
     train = bank.frame([bank.rows(*r) for r in sample.train])
     test_rows = bank.rows(*sample.test)
@@ -144,7 +146,7 @@ def run_draw(
         error = None
         fit_s = predict_s = 0.0
         try:
-            model = new_model(name, params)
+            model = make_model(name, **params)
             t0 = time.perf_counter()
             # Shallow copies: pandas copies on write, so a learner that adds or overwrites
             # columns changes only its own copy and the next learner sees the same frame
@@ -176,26 +178,6 @@ def run_draw(
             }
         )
     return rows
-
-
-#: (learner name, parameter names) -> class, for learners `make_model` has checked once
-_CHECKED: dict[tuple, type] = {}
-
-
-def new_model(name: str, params: dict):
-    """``make_model(name, **params)``; after the first call for a registered learner with
-    these parameter names, its class is called directly: `make_model` checks the names
-    on a throwaway instance (~0.1 ms a job), and the values are checked by ``fit``."""
-    from suds_exp.models import MODELS, make_model
-
-    key = (name, tuple(sorted(params)))
-    cls = _CHECKED.get(key)
-    if cls is not None:
-        return cls(**params)
-    model = make_model(name, **params)
-    if MODELS.get(name) is type(model):
-        _CHECKED[key] = type(model)
-    return model
 
 
 def predicted_velocity(pred) -> np.ndarray:
