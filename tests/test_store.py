@@ -104,6 +104,24 @@ def test_failed_migration_leaves_no_trace(db, tmp_path):
     assert versions == [(1,)]
 
 
+def test_a_new_database_is_opened_once_for_all_its_migrations(db, monkeypatch):
+    """Each migration is its own transaction, but on one connection: opening the file
+    (and checkpointing it on close) per migration made every new database cost ~0.3 s."""
+    import duckdb
+
+    opened = []
+    connect = duckdb.connect
+
+    def counting(*args, **kwargs):
+        opened.append(args[0] if args else kwargs.get("database"))
+        return connect(*args, **kwargs)
+
+    monkeypatch.setattr(duckdb, "connect", counting)
+    applied = Store(db).upgrade()
+    assert applied == [m.name for m in migrate.available_migrations()]
+    assert len(opened) == 1, opened
+
+
 def test_sql_refuses_writes_and_answers_reads(db, make_qtm):
     assert runner.invoke(app, ["ingest", str(make_qtm("a.tsv")), "--db", str(db)]).exit_code == 0
     refused = runner.invoke(app, ["sql", "DELETE FROM trials", "--db", str(db)])

@@ -134,24 +134,28 @@ def apply(engine: sa.Engine, migrations: list[Migration], target: int | None = N
     """Apply those of ``migrations`` not yet in the database, up to version ``target``
     (all when None), each in its own transaction; return their names."""
     migrations = [m for m in migrations if target is None or m.version <= target]
-    with engine.begin() as conn:
-        todo = pending(conn, migrations)
     applied = []
-    for m in todo:
-        with engine.begin() as conn:
-            # DuckDB executes a multi-statement script in the open transaction.
-            try:
-                conn.connection.driver_connection.execute(m.sql)
-            except duckdb.Error as exc:
-                reason = str(exc).strip().splitlines()[0]
-                raise StoreError(
-                    f"migration {m.name}.sql failed and was not applied: {reason}"
-                ) from None
-            conn.execute(
-                sa.text(
-                    "INSERT INTO schema_migrations (version, name, checksum) VALUES (:v, :n, :c)"
-                ),
-                {"v": m.version, "n": m.name, "c": m.checksum},
-            )
-        applied.append(m.name)
+    # one connection for all of them: with NullPool, a connection per migration opened
+    # the file and checkpointed it on close each time, 0.29 s for a new database (0.07 s)
+    with engine.connect() as conn:
+        with conn.begin():
+            todo = pending(conn, migrations)
+        for m in todo:
+            with conn.begin():
+                # DuckDB executes a multi-statement script in the open transaction.
+                try:
+                    conn.connection.driver_connection.execute(m.sql)
+                except duckdb.Error as exc:
+                    reason = str(exc).strip().splitlines()[0]
+                    raise StoreError(
+                        f"migration {m.name}.sql failed and was not applied: {reason}"
+                    ) from None
+                conn.execute(
+                    sa.text(
+                        "INSERT INTO schema_migrations (version, name, checksum) "
+                        "VALUES (:v, :n, :c)"
+                    ),
+                    {"v": m.version, "n": m.name, "c": m.checksum},
+                )
+            applied.append(m.name)
     return applied
