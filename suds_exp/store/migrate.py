@@ -133,29 +133,35 @@ def upgrade(
 def apply(engine: sa.Engine, migrations: list[Migration], target: int | None = None) -> list[str]:
     """Apply those of ``migrations`` not yet in the database, up to version ``target``
     (all when None), each in its own transaction; return their names."""
-    migrations = [m for m in migrations if target is None or m.version <= target]
-    applied = []
     # one connection for all of them: with NullPool, a connection per migration opened
     # the file and checkpointed it on close each time, 0.29 s for a new database (0.07 s)
     with engine.connect() as conn:
+        return apply_on(conn, migrations, target)
+
+
+def apply_on(
+    conn: sa.Connection, migrations: list[Migration], target: int | None = None
+) -> list[str]:
+    """`apply` on an open connection outside a transaction (left outside one)."""
+    migrations = [m for m in migrations if target is None or m.version <= target]
+    with conn.begin():
+        todo = pending(conn, migrations)
+    applied = []
+    for m in todo:
         with conn.begin():
-            todo = pending(conn, migrations)
-        for m in todo:
-            with conn.begin():
-                # DuckDB executes a multi-statement script in the open transaction.
-                try:
-                    conn.connection.driver_connection.execute(m.sql)
-                except duckdb.Error as exc:
-                    reason = str(exc).strip().splitlines()[0]
-                    raise StoreError(
-                        f"migration {m.name}.sql failed and was not applied: {reason}"
-                    ) from None
-                conn.execute(
-                    sa.text(
-                        "INSERT INTO schema_migrations (version, name, checksum) "
-                        "VALUES (:v, :n, :c)"
-                    ),
-                    {"v": m.version, "n": m.name, "c": m.checksum},
-                )
-            applied.append(m.name)
+            # DuckDB executes a multi-statement script in the open transaction.
+            try:
+                conn.connection.driver_connection.execute(m.sql)
+            except duckdb.Error as exc:
+                reason = str(exc).strip().splitlines()[0]
+                raise StoreError(
+                    f"migration {m.name}.sql failed and was not applied: {reason}"
+                ) from None
+            conn.execute(
+                sa.text(
+                    "INSERT INTO schema_migrations (version, name, checksum) VALUES (:v, :n, :c)"
+                ),
+                {"v": m.version, "n": m.name, "c": m.checksum},
+            )
+        applied.append(m.name)
     return applied
