@@ -113,13 +113,24 @@ def test_a_new_database_is_opened_once_for_all_its_migrations(db, monkeypatch):
     connect = duckdb.connect
 
     def counting(*args, **kwargs):
-        opened.append(args[0] if args else kwargs.get("database"))
+        # the file's openings only (the driver probes its settings on ":memory:" once)
+        target = str(args[0] if args else kwargs.get("database"))
+        if target.endswith(".duckdb"):
+            opened.append(target)
         return connect(*args, **kwargs)
 
     monkeypatch.setattr(duckdb, "connect", counting)
     applied = Store(db).upgrade()
     assert applied == [m.name for m in migrate.available_migrations()]
     assert len(opened) == 1, opened
+    # a write block migrates on its own connection: a new file is opened once, too
+    opened.clear()
+    other = db.with_name("other.duckdb")
+    with Store(other).write() as conn:
+        conn.exec_driver_sql("SELECT 1")
+    assert len(opened) == 1, opened
+    versions = Store(other).query_df("SELECT count(*) AS n FROM schema_migrations").n[0]
+    assert versions == len(applied)
 
 
 def test_sql_refuses_writes_and_answers_reads(db, make_qtm):
