@@ -24,6 +24,7 @@ import argparse
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -43,9 +44,20 @@ def _git(*args: str, cwd: Path = ROOT) -> str:
 def _timed(cmd: list[str], cwd: Path) -> tuple[float, str, int]:
     """Wall seconds, the last lines of the output and the exit code of ``cmd``."""
     started = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    # its own process group, so an interrupted run stops make's children (uv, pytest's
+    # workers) too, before the clone is removed
+    proc = subprocess.Popen(
+        cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        start_new_session=True,
+    )  # fmt: skip
+    try:
+        out, _ = proc.communicate()
+    except BaseException:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        raise
     wall = time.perf_counter() - started
-    tail = "\n".join((proc.stdout + proc.stderr).strip().splitlines()[-3:])
+    tail = "\n".join(out.strip().splitlines()[-3:])
     return wall, tail, proc.returncode
 
 
@@ -88,6 +100,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--target", default="test", choices=("test", "demo"))
     ap.add_argument("--keep", action="store_true", help="keep the clones")
     args = ap.parse_args(argv)
+    # a terminated run still removes its clone (the `finally` of `one_round`)
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
 
     sides = {"baseline": _git("rev-parse", "--short", args.baseline)}
     sides["HEAD"] = _git("rev-parse", "--short", "HEAD")
