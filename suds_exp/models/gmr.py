@@ -87,6 +87,7 @@ import pandas as pd
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
+    Columns,
     Learner,
     TimeSeries,
     actuated_columns,
@@ -412,9 +413,12 @@ class GMR(Learner):
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
+        return self._output_frame(self.predict_array(samples), samples)
+
+    def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         self._check_fitted()
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
-        return self._output_frame(self._predict_measured(samples), samples)
+        return self._predict_measured(samples)
 
 
 class GMRSuds(GMR):
@@ -477,13 +481,13 @@ class GMRSuds(GMR):
         ra, dra = actuated_columns(samples)
         return ra + rp + dra, list(VB_COLUMNS) + drp, rp, drp
 
-    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+    def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         self._check_fitted()
         check_mode(self.mode, self.name)
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
         if self.mode == "measured":
-            return self._output_frame(self._predict_measured(samples), samples)
-        return self._output_frame(self._predict_rollout(samples)[0], samples)
+            return self._predict_measured(samples)
+        return self._predict_rollout(samples)[0]
 
     def rollout(self, samples: pd.DataFrame) -> pd.DataFrame:
         """r_p integrated from each trial's first sample, columns rp_1..rp_k, input's index.
