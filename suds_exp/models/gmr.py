@@ -535,7 +535,11 @@ class GMRSuds(GMR):
         R = reg[:, :, rp_idx].transpose(2, 0, 1).reshape(k, -1)  # (k, K * q)
         filt = self.branching == "filter"
         T, pri = self.transition_, self.priors_
-        first = ts.first
+        # The loop runs once a sample, and the gait designer rolls out thousands of gaits:
+        # its scalars come from lists and its reductions are the ufuncs that ndarray.sum,
+        # .max and np.clip call, without their Python wrappers. Same arithmetic.
+        first, dt, fl = ts.first.tolist(), ts.dt.tolist(), fs.tolist()
+        add, largest = np.add.reduce, np.maximum.reduce
         out = np.empty((n, q))
         rp = np.empty((n, k))
         a = pri
@@ -544,16 +548,16 @@ class GMRSuds(GMR):
             if first[t]:
                 x = Xs[t, rp_idx].copy()
             else:
-                x = np.clip(x + ts.dt[t] * fs[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off), lo, hi)
+                x = (x + dt[t] * fl[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off)).clip(lo, hi)
             yk = Y0[t] + (x @ W).reshape(K, -1)
-            lg = c.log_norm - 0.5 * (yk * yk).sum(1)
-            e = np.exp(lg - lg.max())
+            lg = c.log_norm - 0.5 * add(yk * yk, 1)
+            e = np.exp(lg - largest(lg))
             if filt:
                 e = e / pri
                 a = e * (pri if first[t] else a @ T)
             else:
                 a = e
-            s = a.sum()
+            s = add(a)
             a = a / s if s > 0 else pri
             out[t] = a @ (M0[t] + (x @ R).reshape(K, q))
             rp[t] = x
