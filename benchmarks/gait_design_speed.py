@@ -7,8 +7,9 @@ Usage (from the repository root)::
 
 The baseline's `suds_exp` and `cli.py` are exported from git (`git archive`) into a
 temporary folder and its simulator kernels compiled there first (not timed). Rounds
-alternate a worker process on the baseline and one on the working tree (A B A B ...),
-so a change in the machine's load hits both. Each worker, in its own code:
+alternate the baseline and the working tree (each round: every case's worker process on
+the baseline, then on the working tree), so a change in the machine's load hits both.
+Each worker, in its own code:
 
 - builds the small dataset of `tests/test_gait_design.py` (``suds-exp simulate --gaits
   O,D+ --freqs 1/2 --repeats 2 --cycles 6 --ingest``, then ``preprocess``; not timed);
@@ -39,7 +40,8 @@ from statistics import median
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from learner_speed import _export  # noqa: E402  (git archive of the baseline)
+from demo_speed import _run  # noqa: E402  (a worker on one tree)
+from learner_speed import alternate  # noqa: E402  (rounds on an export of the baseline)
 
 #: The design's options beside the learner and --verify (the default test's design).
 DESIGN = ["--bound", "1.3", "--iterations", "2", "--order", "1"]
@@ -116,21 +118,21 @@ def worker(case: str) -> dict:
     return {"cpu": cpu, "wall": wall, "digest": digest, "suds_exp": suds_exp.__file__}
 
 
-def _run(path: Path, *args: str) -> str:
-    env = dict(os.environ, PYTHONPATH=str(path))
-    res = subprocess.run(
-        [sys.executable, *args], env=env, check=True, capture_output=True, text=True, cwd=path
-    )
-    return res.stdout.splitlines()[-1] if res.stdout else ""
+def _runner(commit: str, cases: list[str]):
+    """``run(path)`` for `alternate`: every case's worker on the tree at ``path``. The
+    baseline's export (`learner_speed`'s: `suds_exp` alone) gets its own `cli.py` and its
+    kernels compiled on first use, untimed."""
 
+    def run(path: Path) -> dict:
+        if path != ROOT and not (path / "cli.py").exists():
+            cli = subprocess.run(
+                ["git", "show", f"{commit}:cli.py"], cwd=ROOT, check=True, capture_output=True
+            ).stdout
+            (path / "cli.py").write_bytes(cli)
+            _run(path, "-m", "suds_exp.sim.precompile")
+        return {case: json.loads(_run(path, __file__, "--worker", case)) for case in cases}
 
-def _export_with_cli(commit: str, folder: Path) -> None:
-    """The baseline's `suds_exp` (learner_speed's export) and its `cli.py` beside it."""
-    _export(commit, folder)
-    cli = subprocess.run(
-        ["git", "show", f"{commit}:cli.py"], cwd=ROOT, check=True, capture_output=True
-    ).stdout
-    (folder / "cli.py").write_bytes(cli)
+    return run
 
 
 def main(argv=None) -> int:
@@ -143,17 +145,10 @@ def main(argv=None) -> int:
     if a.worker:
         print(json.dumps(worker(a.worker)))
         return 0
-    runs: dict[str, tuple[list, list]] = {}
-    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
-        _export_with_cli(a.baseline, Path(tmp))
-        _run(Path(tmp), "-m", "suds_exp.sim.precompile")  # its kernels' compile, untimed
-        _run(ROOT, "-m", "suds_exp.sim.precompile")
-        for _ in range(a.rounds):
-            for case in a.cases:
-                base, now = runs.setdefault(case, ([], []))
-                base.append(json.loads(_run(Path(tmp), __file__, "--worker", case)))
-                now.append(json.loads(_run(ROOT, __file__, "--worker", case)))
-    first = next(iter(runs.values()))
+    _run(ROOT, "-m", "suds_exp.sim.precompile")  # the kernels' compile, untimed
+    base, now = alternate(a.baseline, a.rounds, _runner(a.baseline, a.cases))
+    runs = {case: ([r[case] for r in base], [r[case] for r in now]) for case in a.cases}
+    first = runs[a.cases[0]]
     print(
         f"## suds-exp gait design {' '.join(DESIGN)}, {a.rounds} rounds alternating; "
         f"baseline {a.baseline} ({first[0][0]['suds_exp']}), now = working tree "
