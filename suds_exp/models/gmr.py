@@ -536,8 +536,9 @@ class GMRSuds(GMR):
         filt = self.branching == "filter"
         T, pri = self.transition_, self.priors_
         # The loop runs once a sample, and the gait designer rolls out thousands of gaits:
-        # its scalars come from lists and its reductions are the ufuncs that ndarray.sum,
-        # .max and np.clip call, without their Python wrappers. Same arithmetic.
+        # its scalars come from lists, its reductions are the ufuncs ndarray.sum and .max
+        # call and its clip the method np.clip calls, without the Python wrappers. Same
+        # arithmetic.
         first, dt, fl = ts.first.tolist(), ts.dt.tolist(), fs.tolist()
         add, largest = np.add.reduce, np.maximum.reduce
         out = np.empty((n, q))
