@@ -30,6 +30,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.gait.motion import CycleMotion, cycle_motion, integrate_twists
 from suds_exp.gait.shape import TWO_PI, Gait
 from suds_exp.models import make_model
+from suds_exp.models.base import Columns, TimeSeries
 from suds_exp.models.registry import GMR
 from suds_exp.preprocess import get_version
 from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
@@ -82,29 +83,60 @@ def gait_samples(
     """A samples frame of the gait run at frequency_hz (Hz) from phase 0: the standard
     columns (t s, phase rad, ra rad, dra rad/s), r_p (k columns) held at rp0 (mm) for
     a rollout's start, dr_p/dt and v_b as NaN."""
-    n = n_cycles * samples_per_cycle + 1
-    theta = TWO_PI * np.arange(n) / samples_per_cycle
-    ra = gait.shape(theta)
-    dra = gait.rate(theta) * TWO_PI * frequency_hz
-    cols = {
-        "trial_id": np.zeros(n, dtype=np.int64),
-        "frame": np.arange(n),
-        "t": theta / (TWO_PI * frequency_hz),
-        "phase": theta,
-        "cycle": np.arange(n) // samples_per_cycle,
-        "ra_1": ra[:, 0],
-        "ra_2": ra[:, 1],
-        "dra_1": dra[:, 0],
-        "dra_2": dra[:, 1],
-    }
-    rp0 = np.zeros(k) if rp0 is None else np.asarray(rp0, float)
-    for j in range(k):
-        cols[RP_COLUMNS[j]] = np.full(n, rp0[j])
-        cols[DRP_COLUMNS[j]] = np.zeros(n)
-    for c in ("vx", "vy", "wz"):
-        cols[c] = np.full(n, np.nan)
-    cols["frequency_hz"] = np.full(n, float(frequency_hz))
-    return pd.DataFrame(cols)
+    return GaitTable.of(frequency_hz, k, rp0, n_cycles, samples_per_cycle).columns(gait).frame()
+
+
+@dataclass(frozen=True, eq=False)
+class GaitTable:
+    """What `gait_samples` holds that does not depend on the gait, built once for many
+    gaits at one frequency_hz (Hz): the phases ``theta`` (n,) rad (n = n_cycles x
+    samples_per_cycle + 1) and every column but r_a and dr_a/dt, in `gait_samples`'s
+    column order (``head`` before them, ``tail`` after), and the rows' `TimeSeries`."""
+
+    frequency_hz: float
+    samples_per_cycle: int
+    theta: np.ndarray
+    head: dict
+    tail: dict
+    series: TimeSeries
+
+    @classmethod
+    def of(
+        cls,
+        frequency_hz: float,
+        k: int = 0,
+        rp0: np.ndarray | None = None,
+        n_cycles: int = N_CYCLES,
+        samples_per_cycle: int = SAMPLES_PER_CYCLE,
+    ) -> GaitTable:
+        n = n_cycles * samples_per_cycle + 1
+        theta = TWO_PI * np.arange(n) / samples_per_cycle
+        head = {
+            "trial_id": np.zeros(n, dtype=np.int64),
+            "frame": np.arange(n),
+            "t": theta / (TWO_PI * frequency_hz),
+            "phase": theta,
+            "cycle": np.arange(n) // samples_per_cycle,
+        }
+        tail = {}
+        rp0 = np.zeros(k) if rp0 is None else np.asarray(rp0, float)
+        for j in range(k):
+            tail[RP_COLUMNS[j]] = np.full(n, rp0[j])
+            tail[DRP_COLUMNS[j]] = np.zeros(n)
+        for c in ("vx", "vy", "wz"):
+            tail[c] = np.full(n, np.nan)
+        tail["frequency_hz"] = np.full(n, float(frequency_hz))
+        series = TimeSeries.of(Columns(head))
+        for a in (*head.values(), *tail.values(), series.order, series.starts, series.dt):
+            a.flags.writeable = False  # shared by every gait's table
+        return cls(frequency_hz, samples_per_cycle, theta, head, tail, series)
+
+    def columns(self, gait: Gait) -> Columns:
+        """The samples table of ``gait`` (the columns of `gait_samples`)."""
+        ra = gait.shape(self.theta)
+        dra = gait.rate(self.theta) * TWO_PI * self.frequency_hz
+        actuated = {"ra_1": ra[:, 0], "ra_2": ra[:, 1], "dra_1": dra[:, 0], "dra_2": dra[:, 1]}
+        return Columns(self.head | actuated | self.tail, self.series)
 
 
 def build_learner(name: str, params: dict | None = None):
@@ -126,14 +158,43 @@ def rollout_motion(
 ) -> CycleMotion:
     """Net motion per cycle of ``gait`` at frequency_hz predicted by a fitted ``model``
     (SE(2) integral of its predicted v_b; mean of cycles `MEASURED`)."""
-    # a learner without memory (no r_p to roll, no branch history) repeats every cycle
-    memoryless = k == 0 and getattr(model, "branching", "none") == "none"
-    cycles, measured = ((1,), (0,)) if memoryless else ((N_CYCLES,), MEASURED)
-    frame = gait_samples(gait, frequency_hz, k, rp0, cycles[0], samples_per_cycle)
-    vb = model.predict(frame)[["vx", "vy", "wz"]].to_numpy(float)
-    dt = 1 / (frequency_hz * samples_per_cycle)
-    poses = integrate_twists(vb, dt)
-    return cycle_motion(poses, samples_per_cycle, measured, vb[:, 0])
+    return Rollout.of(model, frequency_hz, k, rp0, samples_per_cycle).motion(gait)
+
+
+@dataclass(frozen=True, eq=False)
+class Rollout:
+    """`rollout_motion` of one fitted ``model`` at one frequency, for many gaits: the
+    gait's table (`GaitTable`) is built once, the model predicts from arrays
+    (`Learner.predict_array`, the numbers of its `predict`); ``measured`` the cycles
+    averaged."""
+
+    model: object
+    table: GaitTable
+    measured: tuple
+
+    @classmethod
+    def of(
+        cls,
+        model,
+        frequency_hz: float,
+        k: int = 0,
+        rp0: np.ndarray | None = None,
+        samples_per_cycle: int = SAMPLES_PER_CYCLE,
+    ) -> Rollout:
+        # a learner without memory (no r_p to roll, no branch history) repeats every cycle
+        memoryless = k == 0 and getattr(model, "branching", "none") == "none"
+        cycles, measured = (1, (0,)) if memoryless else (N_CYCLES, MEASURED)
+        return cls(model, GaitTable.of(frequency_hz, k, rp0, cycles, samples_per_cycle), measured)
+
+    def motion(self, gait: Gait) -> CycleMotion:
+        """Net motion per cycle of ``gait`` (see `rollout_motion`)."""
+        spc = self.table.samples_per_cycle
+        values = self.model.predict_array(self.table.columns(gait))
+        # the layout a predicted frame's [vx, vy, wz].to_numpy() has: same arithmetic after
+        vb = np.asfortranarray(values[:, :3])
+        dt = 1 / (self.table.frequency_hz * spc)
+        poses = integrate_twists(vb, dt)
+        return cycle_motion(poses, spc, self.measured, vb[:, 0])
 
 
 @dataclass
@@ -144,9 +205,16 @@ class FittedMap:
     model: object
     k: int
     rp0: np.ndarray
+    _rollouts: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def motion(self, gait: Gait, frequency_hz: float) -> CycleMotion:
-        return rollout_motion(self.model, gait, frequency_hz, self.k, self.rp0)
+        # one Rollout a frequency: the designer evaluates thousands of gaits at one
+        roll = self._rollouts.get(frequency_hz)
+        if roll is None:
+            roll = self._rollouts[frequency_hz] = Rollout.of(
+                self.model, frequency_hz, self.k, self.rp0
+            )
+        return roll.motion(gait)
 
     def forward(self, gait: Gait, frequency_hz: float) -> float:
         return self.motion(gait, frequency_hz).forward_mm

@@ -55,11 +55,45 @@ def actuated_columns(samples: pd.DataFrame) -> tuple[list[str], list[str]]:
     return [f"ra_{i}" for i in range(1, m + 1)], [f"dra_{i}" for i in range(1, m + 1)]
 
 
-def require_columns(samples: pd.DataFrame, columns, model: str) -> None:
+@dataclass(frozen=True, eq=False)
+class Columns:
+    """A samples table as named column arrays, each of shape (n_samples,): the cheap form
+    of a samples frame that `Learner.predict_array` reads too. A caller that predicts
+    thousands of small tables (the gait designer rolls one out per candidate gait) saves
+    building a DataFrame and reading it back column by column; the numbers are the same.
+    ``series``: the rows' `TimeSeries` when the caller already has it (many tables on the
+    same trial_id and t columns), else None (computed when a learner needs it).
+    """
+
+    data: dict
+    series: TimeSeries | None = None
+
+    def __len__(self) -> int:
+        return len(next(iter(self.data.values()))) if self.data else 0
+
+    def __contains__(self, name) -> bool:
+        return name in self.data
+
+    def __getitem__(self, name) -> np.ndarray:
+        return self.data[name]
+
+    def frame(self) -> pd.DataFrame:
+        """The same table as a samples DataFrame (columns in `data`'s order)."""
+        return pd.DataFrame(self.data)
+
+
+def column(samples: pd.DataFrame | Columns, name: str, dtype=None) -> np.ndarray:
+    """One column of a samples frame or `Columns` as an array (n_samples,)."""
+    if isinstance(samples, Columns):
+        return np.asarray(samples[name], dtype=dtype)
+    return samples[name].to_numpy(dtype=dtype)
+
+
+def require_columns(samples: pd.DataFrame | Columns, columns, model: str) -> None:
     """Raise ModelError naming the first missing column."""
-    if not isinstance(samples, pd.DataFrame):
+    if not isinstance(samples, pd.DataFrame | Columns):
         raise ModelError(f"{model}: expected a pandas DataFrame of samples, got {type(samples)}")
-    missing = [c for c in columns if c not in samples.columns]
+    missing = [c for c in columns if c not in samples]
     if missing:
         raise ModelError(
             f"{model}: samples frame lacks column(s) {', '.join(missing)}; "
@@ -69,10 +103,14 @@ def require_columns(samples: pd.DataFrame, columns, model: str) -> None:
         raise ModelError(f"{model}: samples frame is empty")
 
 
-def as_array(samples: pd.DataFrame, columns, model: str) -> np.ndarray:
+def as_array(samples: pd.DataFrame | Columns, columns, model: str) -> np.ndarray:
     """Columns as a float array of shape (n_samples, len(columns)); NaN/inf is an error."""
     columns = list(columns)
-    if samples.columns.is_unique:
+    if isinstance(samples, Columns):
+        x = np.empty((len(samples), len(columns)), order="F")
+        for j, c in enumerate(columns):
+            x[:, j] = samples[c]
+    elif samples.columns.is_unique:
         # Column by column: a quarter of the time of .loc[:, columns].to_numpy() on the
         # many-block frames learners get (pandas builds an index and a block manager for
         # the subset first). Same values, and the same Fortran layout that call returns
@@ -102,9 +140,11 @@ class TimeSeries:
     dt: np.ndarray
 
     @classmethod
-    def of(cls, samples: pd.DataFrame) -> TimeSeries:
-        trial = samples["trial_id"].to_numpy() if "trial_id" in samples else np.zeros(len(samples))
-        t = samples["t"].to_numpy(dtype=float)
+    def of(cls, samples: pd.DataFrame | Columns) -> TimeSeries:
+        if isinstance(samples, Columns) and samples.series is not None:
+            return samples.series
+        trial = column(samples, "trial_id") if "trial_id" in samples else np.zeros(len(samples))
+        t = column(samples, "t", float)
         order = np.lexsort((t, trial))
         ts, tr = t[order], trial[order]
         new = np.ones(len(order), dtype=bool)
@@ -200,6 +240,14 @@ class Learner(BaseEstimator):
 
     name = "learner"
     suds = False
+
+    def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
+        """`predict`'s numbers as an array (n_samples, n_outputs): vx, vy (mm/s), wz
+        (rad/s) [, drp_1..drp_k], in the caller's row order; ``samples`` a samples frame
+        or `Columns`. Learners with a cheaper array path override this, and their
+        `predict` is that array in a frame, so the two always agree."""
+        frame = samples.frame() if isinstance(samples, Columns) else samples
+        return self.predict(frame).to_numpy(dtype=float)
 
     def _output_frame(self, values: np.ndarray, samples: pd.DataFrame) -> pd.DataFrame:
         cols = list(VB_COLUMNS) + (list(self.drp_columns_) if self.suds else [])

@@ -87,6 +87,7 @@ import pandas as pd
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
+    Columns,
     Learner,
     TimeSeries,
     actuated_columns,
@@ -412,9 +413,12 @@ class GMR(Learner):
 
     def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
         """Predicted vx, vy (mm/s), wz (rad/s) [, drp_1..drp_k], same index as `samples`."""
+        return self._output_frame(self.predict_array(samples), samples)
+
+    def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         self._check_fitted()
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
-        return self._output_frame(self._predict_measured(samples), samples)
+        return self._predict_measured(samples)
 
 
 class GMRSuds(GMR):
@@ -477,13 +481,13 @@ class GMRSuds(GMR):
         ra, dra = actuated_columns(samples)
         return ra + rp + dra, list(VB_COLUMNS) + drp, rp, drp
 
-    def predict(self, samples: pd.DataFrame) -> pd.DataFrame:
+    def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         self._check_fitted()
         check_mode(self.mode, self.name)
         require_columns(samples, ("trial_id", "t", *self.columns_in_), self.name)
         if self.mode == "measured":
-            return self._output_frame(self._predict_measured(samples), samples)
-        return self._output_frame(self._predict_rollout(samples)[0], samples)
+            return self._predict_measured(samples)
+        return self._predict_rollout(samples)[0]
 
     def rollout(self, samples: pd.DataFrame) -> pd.DataFrame:
         """r_p integrated from each trial's first sample, columns rp_1..rp_k, input's index.
@@ -531,7 +535,12 @@ class GMRSuds(GMR):
         R = reg[:, :, rp_idx].transpose(2, 0, 1).reshape(k, -1)  # (k, K * q)
         filt = self.branching == "filter"
         T, pri = self.transition_, self.priors_
-        first = ts.first
+        # The loop runs once a sample, and the gait designer rolls out thousands of gaits:
+        # its scalars come from lists, its reductions are the ufuncs ndarray.sum and .max
+        # call and its clip the method np.clip calls, without the Python wrappers. Same
+        # arithmetic.
+        first, dt, fl = ts.first.tolist(), ts.dt.tolist(), fs.tolist()
+        add, largest = np.add.reduce, np.maximum.reduce
         out = np.empty((n, q))
         rp = np.empty((n, k))
         a = pri
@@ -540,16 +549,16 @@ class GMRSuds(GMR):
             if first[t]:
                 x = Xs[t, rp_idx].copy()
             else:
-                x = np.clip(x + ts.dt[t] * fs[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off), lo, hi)
+                x = (x + dt[t] * fl[t - 1] * (gain * out[t - 1, 3 : 3 + k] + off)).clip(lo, hi)
             yk = Y0[t] + (x @ W).reshape(K, -1)
-            lg = c.log_norm - 0.5 * (yk * yk).sum(1)
-            e = np.exp(lg - lg.max())
+            lg = c.log_norm - 0.5 * add(yk * yk, 1)
+            e = np.exp(lg - largest(lg))
             if filt:
                 e = e / pri
                 a = e * (pri if first[t] else a @ T)
             else:
                 a = e
-            s = a.sum()
+            s = add(a)
             a = a / s if s > 0 else pri
             out[t] = a @ (M0[t] + (x @ R).reshape(K, q))
             rp[t] = x
