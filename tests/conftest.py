@@ -15,25 +15,25 @@ import pytest
 SHARED = Path(os.environ.get("SUDS_SHARED") or Path(__file__).resolve().parents[2] / "shared")
 
 
-# The default run's slowest files (`pytest --durations`, docs/results/speed.md session 15),
+# The default run's slowest files (`pytest --durations`, docs/results/speed.md session 16),
 # slowest first. `make test` hands whole files to its 2 workers in collection order
 # (`--dist loadfile`): starting these first keeps one of them from being the last thing a
 # worker runs while the other waits.
 SLOW_FILES = (
     "test_discrepancy_workflow.py",
-    "test_campaign_kill.py",
-    "test_gait_design.py",
     "test_reliability.py",
-    "test_ingest_cli.py",
+    "test_gait_design.py",
+    "test_campaign_kill.py",
     "test_docs.py",
+    "test_ingest_cli.py",
     "test_experiment_design.py",
-    "test_campaign_parallel.py",
-    "test_preprocess_reduction.py",
-    "test_campaign_skip.py",
-    "test_body_segments.py",
     "test_preprocess_versions.py",
+    "test_campaign_parallel.py",
+    "test_analysis_report.py",
+    "test_preprocess_reduction.py",
     "test_campaign_runner.py",
-    "test_models_api.py",
+    "test_body_segments.py",
+    "test_models_sklearn.py",
     "test_stream.py",
 )
 
