@@ -63,17 +63,8 @@ class Store:
         Refuses (`StoreError`) before the file or its folder is touched when no migration
         files are installed."""
         migrations = migrate.available_migrations()
-        with self.locked("init"):
-            engine = make_engine(self.path)
-            try:
-                applied = retry_on_lock(
-                    lambda: migrate.apply(engine, migrations, target), self.path
-                )
-            except (duckdb.Error, sa.exc.DBAPIError) as exc:
-                raise _write_problem(exc, self.path) from None
-            finally:
-                engine.dispose()
-                mark_written(self.path)
+        with self.locked("init"), self._writable() as conn:
+            applied = migrate.apply_on(conn, migrations, target)
         if target is None:
             self._migrated = True
         return applied
@@ -86,20 +77,14 @@ class Store:
         for the whole block, and DuckDB checkpoints once when it ends instead of after
         every transaction.
         """
-        with self.locked("write"):
+        migrations = None if self._migrated else migrate.available_migrations()
+        with self.locked("write"), self._writable() as conn:
             # pending migrations first, on the block's own connection: a second opening
             # of the file (~14 ms with its checkpoint) per command otherwise
-            migrations = None if self._migrated else migrate.available_migrations()
-            try:
-                with self._connect(read_only=False) as conn:
-                    if migrations is not None:
-                        migrate.apply_on(conn, migrations)
-                        self._migrated = True
-                    yield conn
-            except (duckdb.Error, sa.exc.DBAPIError) as exc:
-                raise _write_problem(exc, self.path) from None
-            finally:
-                mark_written(self.path)
+            if migrations is not None:
+                migrate.apply_on(conn, migrations)
+                self._migrated = True
+            yield conn
 
     @contextmanager
     def write(self) -> Iterator[sa.Connection]:
@@ -117,6 +102,18 @@ class Store:
         migrate.available_migrations()
         with self._connect(read_only=True) as conn:
             yield conn
+
+    @contextmanager
+    def _writable(self) -> Iterator[sa.Connection]:
+        # a refused write in one line (`_write_problem`), and the file's integrity record
+        # renewed whatever happened
+        try:
+            with self._connect(read_only=False) as conn:
+                yield conn
+        except (duckdb.Error, sa.exc.DBAPIError) as exc:
+            raise _write_problem(exc, self.path) from None
+        finally:
+            mark_written(self.path)
 
     @contextmanager
     def _connect(self, read_only: bool) -> Iterator[sa.Connection]:
