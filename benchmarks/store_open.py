@@ -35,7 +35,7 @@ from statistics import median
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from learner_speed import _export  # noqa: E402  (git archive of the baseline)
+from learner_speed import alternate  # noqa: E402  (baseline export, alternating rounds)
 
 CASES = ("new database", "first write", "read")
 
@@ -99,12 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     if a.worker:
         print(json.dumps(worker(a.repeats)))
         return 0
-    base, now = [], []
-    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
-        _export(a.baseline, Path(tmp))
-        for _ in range(a.rounds):
-            base.append(_run(Path(tmp), a.repeats))
-            now.append(_run(ROOT, a.repeats))
+    base, now = alternate(a.baseline, a.rounds, lambda path: _run(path, a.repeats))
     print(
         f"## Opening the database, {a.rounds} rounds x {a.repeats} repeats alternating; "
         f"baseline {a.baseline}, now = working tree; load average {os.getloadavg()[0]:.2f}"
