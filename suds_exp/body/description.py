@@ -5,13 +5,17 @@ Two kinds of body:
 - **segments**: rigid segments, each with its markers and their roles (at least 2
   markers, or none with ``from_joints = true`` when the segment is located by its joints,
   as the swimmer's middle segment is), joints between segments (``actuated`` or
-  ``passive``; they must form a tree in which each segment is the child of at most one
-  joint), and passive markers hanging from a segment. ``frame`` lists the markers fixed
+  ``passive``; they must form one tree that connects every segment, in which each
+  segment is the child of at most one joint), and passive markers hanging from a
+  segment. ``frame`` lists the markers fixed
   on a segment that give its pose (default: all of them; the first two set its origin,
   their midpoint, and its first direction); its other markers are measured in its frame
-  as passive state, like the passive markers. A joint's angle is the heading of its
-  child's axis minus its parent's: write each joint from the tail side (parent) to the
-  head side (child)::
+  as passive state, like the passive markers. A joint's angle is its bend: zero when the
+  two segments are in line, positive when the child turns counter-clockwise seen from
+  above (`suds_exp.body.segments` defines it exactly); it does not depend on which
+  segment is the body frame or on the order joints are listed, and writing a joint's
+  parent and child the other way round flips its sign. Write each joint from the tail
+  side (parent) to the head side (child) to get the swimmer's signs::
 
       name = "swimmer"
       body_frame = "middle"
@@ -285,7 +289,27 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
     for seg in segments:
         if seg.from_joints and not any(seg.name in (j.parent, j.child) for j in joints):
             raise BodyError(f"{src}: segments.{seg.name}: from_joints = true but no joint has it")
+    _check_connected(src, names, joints, frame)
     return Body(name, src, segments, joints, dict(passive), frame)
+
+
+def _check_connected(src: str, names: list[str], joints: list[Joint], frame: str) -> None:
+    """Refuse a segment the joints do not connect to the body frame's segment (its
+    markers would otherwise be read and silently left out)."""
+    reached, todo = {frame}, [frame]
+    while todo:
+        here = todo.pop()
+        for j in joints:
+            for near, far in ((j.parent, j.child), (j.child, j.parent)):
+                if near == here and far not in reached:
+                    reached.add(far)
+                    todo.append(far)
+    for name in names:
+        if name not in reached:
+            raise BodyError(
+                f"{src}: segments.{name}: joined to no other segment; every segment must be "
+                "connected to the body by joints (add a [[joints]] entry or remove the segment)"
+            )
 
 
 def _check_tree(src: str, names: list[str], joints: list[Joint]) -> None:

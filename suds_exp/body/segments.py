@@ -5,26 +5,42 @@ Per trial, from the cleaned markers:
 - the motion plane: the least-squares plane of every segment marker (as the swimmer's);
 - each segment with markers gets a 2D frame: origin at the midpoint of its first two
   ``frame`` markers, angle the heading from the first to the second, refined by a
-  per-frame least-squares rigid fit of all its frame markers when it has more than two;
+  per-frame least-squares rigid fit of all its frame markers when it has more than two.
+  A segment's pose comes from the markers the capture saw in that frame whenever at
+  least two of its frame markers were seen (their positions in its frame are learned
+  from the frames that saw them all); only where fewer were seen does it come from the
+  cleaning step's interpolated tracks (counted per segment, ``interpolated_frames``);
 - each joint's centre is a point fixed in the frames of both segments it joins (linear
   least squares over every frame of the version's trials); a segment without markers
   (``from_joints``) is the link between its two joints, whose centres are the points of
   its neighbours' frames that keep a constant distance (as the swimmer's motor axes);
-- each segment's axis runs from its parent joint to its first child joint; a segment
-  with one joint runs between that joint and its frame origin. A joint's angle is the
-  heading of its child's axis minus its parent's (rad);
+- a joint's angle is its **bend**, defined by the joint alone: each of the two segments
+  it joins points along the line from its *far point* to the joint (the parent) or from
+  the joint to its far point (the child), where a segment's far point is its other
+  joint's centre when it has exactly two joints, else its frame origin. The angle is the
+  heading of the child's line minus the parent's (rad): zero when the two are in line,
+  positive when the child turns counter-clockwise seen from above (the right-hand rule
+  about the motion plane's upward normal). It does not depend on which segment is the
+  root, which is the body frame, or the order of the joints in the file; swapping a
+  joint's parent and child flips its sign;
+- each segment's axis (the X of the frame its passive state is measured in, and the
+  body frame's): from its parent joint to its child joint when it has exactly one, else
+  to its frame origin; a segment that is no joint's child runs from its frame origin to
+  its one child joint, or, with several, along its frame's +X (first frame marker to
+  the second);
 - the body frame is the ``body_frame`` segment's: origin at the midpoint of its joints
   (a ``from_joints`` segment) or at its frame origin, +X along its axis;
-- r_a: the actuated joints' angles (rad, description order); the passive state (mm, the
+- r_a: the actuated joints' angles (rad, in the order the description lists them: the
+  one thing that order sets); the passive state (mm, the
   paper's Cartesian choice): each segment's non-frame markers and each passive marker in
   its segment's frame (origin at the segment's joint towards the body frame, X along its
-  axis), then, for each passive joint, the far segment's origin in the near segment's
-  frame. The pipeline then reduces the passive state by PCA, takes the phase from r_a,
-  differentiates and writes samples as for the swimmer.
+  axis), then, for each passive joint in the order of their names, the far segment's
+  origin in the near segment's frame. The pipeline then reduces the passive state by
+  PCA, takes the phase from r_a, differentiates and writes samples as for the swimmer.
 
 Written as such a description (`suds_exp/body/swimmer.toml`), the swimmer gives the same
 numbers as the built-in pipeline with the segment-frame settings (``tail_fit=rigid``,
-``body_fit=segments``); the built-in default's chain fit and flipper circles use facts
+``body_fit=segments``) on trials that lose no tail frame marker; the built-in default's chain fit and flipper circles use facts
 of that one robot and are not generic.
 """
 
@@ -32,7 +48,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -45,8 +61,9 @@ from suds_exp.preprocess.body_frame import (
     SegmentFrames,
     fit_joints,
     fit_plane,
-    rigid_fit,
+    procrustes,
     rotate,
+    to_frame,
 )
 from suds_exp.preprocess.body_model import BodyModel
 from suds_exp.preprocess.kinematics import Kinematics
@@ -61,12 +78,14 @@ SWIMMER_ONLY = {"body_fit": "segments", "tail_fit": "rigid", "ra_repr": "angles"
 @dataclass(frozen=True)
 class SegMeasured:
     """A trial's markers in its motion plane: ``local`` (n_frames, n_markers, 2) mm (the
-    model's label order), the `Plane`, and each marker segment's frame: name ->
-    (origin (n_frames, 2) mm, angle (n_frames,) rad)."""
+    model's label order), the `Plane`, each marker segment's frame: name -> (origin
+    (n_frames, 2) mm, angle (n_frames,) rad), and how many frames of each marker segment
+    took their pose from interpolated tracks (too few of its frame markers seen)."""
 
     plane: Plane
     local: np.ndarray
     frames: dict[str, tuple[np.ndarray, np.ndarray]]
+    interpolated_frames: dict[str, int] = field(default_factory=dict)
 
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
@@ -97,7 +116,10 @@ class SegmentModel(BodyModel):
         self.body = body
         self.segments = {s.name: s for s in body.segments}
         self.actuated = [j for j in body.joints if j.kind == "actuated"]
-        self.passive_joints = [j for j in body.joints if j.kind == "passive"]
+        # by name, so the passive state does not depend on the order joints are listed
+        self.passive_joints = sorted(
+            (j for j in body.joints if j.kind == "passive"), key=lambda j: j.name
+        )
         src = body.source
         if not 1 <= len(self.actuated) <= MAX_ACTUATED:
             raise BodyError(
@@ -107,6 +129,9 @@ class SegmentModel(BodyModel):
         self.parent_joint = {j.child: j for j in body.joints}
         self.child_joints = {
             s.name: [j for j in body.joints if j.parent == s.name] for s in body.segments
+        }
+        self.joints_of = {
+            s.name: [j for j in body.joints if s.name in (j.parent, j.child)] for s in body.segments
         }
         for seg in body.segments:
             if not seg.from_joints:
@@ -180,29 +205,31 @@ class SegmentModel(BodyModel):
     def missing(self, trial_id: int, lacking: Sequence[str]) -> str:
         return f"{self.body.source}: marker(s) {', '.join(lacking)} unknown to trial {trial_id}"
 
-    def measure(self, xyz: np.ndarray, params: dict[str, Any]) -> SegMeasured:
+    def measure(
+        self, xyz: np.ndarray, params: dict[str, Any], filled: np.ndarray | None = None
+    ) -> SegMeasured:
+        """The trial's plane and segment frames from cleaned tracks ``xyz`` (n_frames,
+        n_markers, 3) mm; ``filled`` (n_frames, n_markers) bool marks the points the
+        cleaning step interpolated (none when omitted)."""
         xyz = np.asarray(xyz, dtype=float)
         cols = self._col
         plane = fit_plane(
             xyz[:, [cols[m] for m in self.plane_markers]], xyz[:, [cols[m] for m in self.leading]]
         )
         local = plane.project(xyz)[..., :2]
-        frames = {}
+        frames, interpolated = {}, {}
         for seg in self.body.segments:
             if seg.from_joints:
                 continue
-            names = seg.frame_markers
-            two = local[:, [cols[m] for m in names[:2]]]
-            d = two[:, 1] - two[:, 0]
-            if np.any(np.hypot(d[:, 0], d[:, 1]) < 1e-6):
-                raise PreprocessError(
-                    f"segment {seg.name}: its frame markers {names[0]} and {names[1]} coincide"
-                )
-            origin, angle = two.mean(axis=1), np.arctan2(d[:, 1], d[:, 0])
-            if len(names) > 2:
-                origin, angle = rigid_fit(local[:, [cols[m] for m in names]], origin, angle)
-            frames[seg.name] = (origin, angle)
-        return SegMeasured(plane, local, frames)
+            index = [cols[m] for m in seg.frame_markers]
+            seen = np.ones((len(xyz), len(index)), bool) if filled is None else ~filled[:, index]
+            frames[seg.name], interpolated[seg.name] = _segment_pose(
+                seg.name, seg.frame_markers, local[:, index], seen
+            )
+        return SegMeasured(plane, local, frames, interpolated)
+
+    def interpolated_frames(self, measured: SegMeasured) -> int:
+        return sum(measured.interpolated_frames.values())
 
     def fit_joints(self, measured: Sequence[SegMeasured]) -> dict:
         """Each joint's centre as ``{joint: {segment: [x, y] mm in its frame}}``, and each
@@ -248,22 +275,42 @@ class SegmentModel(BodyModel):
         return out
 
     def _axes(self, measured: SegMeasured, points: dict) -> dict[str, np.ndarray]:
-        """Each segment's axis heading (n_frames,) rad, the body frame's unwrapped."""
+        """Each segment's axis heading (n_frames,) rad (the module docstring's rule, which
+        no listing order enters), the body frame's unwrapped."""
         out = {}
         for seg in self.body.segments:
             parent = self.parent_joint.get(seg.name)
             kids = self.child_joints[seg.name]
-            start = points[parent.name] if parent else measured.frames[seg.name][0]
-            if kids:
-                end = points[kids[0].name]
-            elif parent:
-                end = measured.frames[seg.name][0]
+            origin = None if seg.from_joints else measured.frames[seg.name][0]
+            one_kid = points[kids[0].name] if len(kids) == 1 else None
+            if parent is not None:
+                start, end = points[parent.name], one_kid if one_kid is not None else origin
+            elif one_kid is not None:
+                start, end = origin, one_kid
             else:
                 out[seg.name] = measured.frames[seg.name][1]
                 continue
             out[seg.name] = _heading(end - start)
         out[self.body.body_frame] = np.unwrap(out[self.body.body_frame])
         return out
+
+    def _far_point(self, seg: str, joint: str, measured: SegMeasured, points: dict) -> np.ndarray:
+        """(n_frames, 2) mm: the point a segment's side of ``joint`` points to: its other
+        joint's centre when it has exactly two joints, else its frame origin."""
+        joints = self.joints_of[seg]
+        if len(joints) == 2:
+            return points[next(j.name for j in joints if j.name != joint)]
+        return measured.frames[seg][0]
+
+    def _bends(self, measured: SegMeasured, points: dict, joints) -> np.ndarray:
+        """The bends (n_frames, len(joints)) rad of ``joints``, each continuous in time."""
+        out = []
+        for j in joints:
+            at = points[j.name]
+            before = at - self._far_point(j.parent, j.name, measured, points)
+            after = self._far_point(j.child, j.name, measured, points) - at
+            out.append(_wrap(_heading(after) - _heading(before)))
+        return np.unwrap(np.stack(out, axis=1), axis=0)
 
     def pose(self, measured: SegMeasured, joints: dict):
         """(joint centres by name, axis headings by segment, body origin (n_frames, 2) mm,
@@ -280,10 +327,11 @@ class SegmentModel(BodyModel):
         return points, axes, xy, axes[frame]
 
     def joint_angles(self, measured: SegMeasured, joints: dict) -> dict[str, np.ndarray]:
-        """Every joint's angle (n_frames,) rad, heading of its child's axis minus its
-        parent's, continuous in time."""
-        _, axes, _, _ = self.pose(measured, joints)
-        return {j.name: np.unwrap(_wrap(axes[j.child] - axes[j.parent])) for j in self.body.joints}
+        """Every joint's bend (n_frames,) rad (the module docstring's definition),
+        continuous in time."""
+        points = self._joint_points(measured, joints)
+        bends = self._bends(measured, points, self.body.joints)
+        return {j.name: bends[:, i] for i, j in enumerate(self.body.joints)}
 
     def _in_segment(self, p, seg, points, axes, xy):
         towards = self.towards_body.get(seg)
@@ -294,10 +342,7 @@ class SegmentModel(BodyModel):
 
     def kinematics(self, measured, joints, params, rate_hz, frequency_hz) -> Kinematics:
         points, axes, xy, heading = self.pose(measured, joints)
-        ra = np.unwrap(
-            np.stack([_wrap(axes[j.child] - axes[j.parent]) for j in self.actuated], axis=1),
-            axis=0,
-        )
+        ra = self._bends(measured, points, self.actuated)
         cols = []
         for marker, seg in self.hanging:
             p = measured.local[:, self._col[marker]]
@@ -331,6 +376,39 @@ class SegmentModel(BodyModel):
                 spread.append(float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=1)))))
         rms = float(np.sqrt(np.mean(np.square(spread)))) if spread else 0.0
         return measured.plane.basis[2].tolist(), length, rms
+
+
+def _segment_pose(
+    name: str, markers: Sequence[str], points: np.ndarray, seen: np.ndarray
+) -> tuple[tuple[np.ndarray, np.ndarray], int]:
+    """A rigid segment's frame ((origin (n, 2) mm, angle (n,) rad)) from its frame
+    markers ``points`` (n, m, 2) mm (gaps filled by interpolation) and which of them the
+    capture saw (``seen`` (n, m) bool), and the number of frames whose pose rests on
+    interpolated points (fewer than two seen)."""
+    two = points[:, :2]
+    d = two[:, 1] - two[:, 0]
+    if np.any(np.hypot(d[:, 0], d[:, 1]) < 1e-6):
+        raise PreprocessError(
+            f"segment {name}: its frame markers {markers[0]} and {markers[1]} coincide"
+        )
+    origin, angle = two.mean(axis=1), np.arctan2(d[:, 1], d[:, 0])
+    n_seen = seen.sum(axis=1)
+    if len(markers) > 2:
+        # the markers' places in the first estimate's frame, learned from the frames that
+        # saw them all (`rigid_fit`'s, when none is missing), then each frame's rigid fit:
+        # of every marker, or of those seen where two or more are
+        full = n_seen == len(markers)
+        ref = full if full.any() else np.ones(len(full), bool)
+        template = to_frame(points[ref], origin[ref], angle[ref]).mean(axis=0)
+        origin, angle = procrustes(template, points, angle)
+        partial = (n_seen >= 2) & ~full
+        for mask in {tuple(row) for row in seen[partial]}:
+            keep = np.asarray(mask)
+            rows = partial & (seen == keep).all(axis=1)
+            origin[rows], angle[rows] = procrustes(
+                template[keep], points[rows][:, keep], angle[rows]
+            )
+    return (origin, angle), int((n_seen < 2).sum())
 
 
 def _common_point(

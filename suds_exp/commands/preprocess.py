@@ -55,6 +55,12 @@ def preprocess_text(result) -> str:
         f"trials ({result.n_samples} samples), skipped {len(result.skipped)} already done, "
         f"in {result.seconds:.1f} s; "
         f"{explained_label(result.params)} explain {ev}"
+        + (
+            f"; {result.interpolated_pose_frames} segment poses interpolated (too few "
+            "markers seen)"
+            if result.interpolated_pose_frames
+            else ""
+        )
     )
 
 

@@ -47,9 +47,17 @@ class BodyModel:
         """The one-line message for a trial lacking markers of these labels."""
         return f"trial {trial_id}: has no marker {', '.join(lacking)}"
 
-    def measure(self, xyz: np.ndarray, params: dict[str, Any]) -> Any:
-        """Per-trial geometry from cleaned tracks (n_frames, len(labels), 3) mm."""
+    def measure(
+        self, xyz: np.ndarray, params: dict[str, Any], filled: np.ndarray | None = None
+    ) -> Any:
+        """Per-trial geometry from cleaned tracks (n_frames, len(labels), 3) mm;
+        ``filled`` (n_frames, len(labels)) bool marks the points cleaning interpolated."""
         raise NotImplementedError
+
+    def interpolated_frames(self, measured: Any) -> int:
+        """Frames of ``measured`` (summed over segments) whose pose rests on interpolated
+        points; 0 for a model that does not tell."""
+        return 0
 
     def fit_joints(self, measured: Sequence[Any]) -> Any:
         """What the version shares, fitted on the measured trials (the joint positions)."""
@@ -95,7 +103,7 @@ class SwimmerModel(BodyModel):
             "re-ingest it with a layout naming them"
         )
 
-    def measure(self, xyz: np.ndarray, params: dict[str, Any]):
+    def measure(self, xyz: np.ndarray, params: dict[str, Any], filled=None):
         return measure(xyz, params["tail_fit"])
 
     def fit_joints(self, measured: Sequence[Any]) -> Joints:

@@ -54,7 +54,10 @@ class PrepResult:
     """What a `preprocess` run did.
 
     ``processed``/``skipped``: trial ids written now / already done before;
-    ``explained_variance_ratio``: of the k kept passive components (fraction each).
+    ``explained_variance_ratio``: of the k kept passive components (fraction each);
+    ``interpolated_pose_frames``: frames of a segment, summed over segments and the
+    trials processed now, whose pose came from interpolated tracks because too few of
+    its markers were seen (a segment body's; the swimmer's pipeline reports none).
     """
 
     version_id: int
@@ -66,6 +69,7 @@ class PrepResult:
     skipped: list[int] = field(default_factory=list)
     explained_variance_ratio: list[float] = field(default_factory=list)
     n_samples: int = 0
+    interpolated_pose_frames: int = 0
     seconds: float = 0.0
 
     def to_dict(self) -> dict:
@@ -181,7 +185,7 @@ def _prepare(meta_row, tracks, params: dict, model: BodyModel) -> _Trial:
     max_gap = int(np.floor(params["max_gap_s"] * rate + 1e-9))
     try:
         cleaned = clean_tracks(xyz, params["jump_mm"], max_gap, [f"{r}" for r in model.labels])
-        measured = model.measure(cleaned.xyz, params)
+        measured = model.measure(cleaned.xyz, params, cleaned.filled)
     except PreprocessError as exc:
         raise PreprocessError(f"{label}: {exc}", param=exc.param) from None
     gait = meta_row.gait if isinstance(meta_row.gait, str) else None
@@ -506,6 +510,9 @@ def write_samples(
                     [_stats_row(b, vid, fitted.joints[b.id], model) for b in batch]
                 )
                 write_trials(store, result, pd.concat(frames, ignore_index=True), stats)
+                result.interpolated_pose_frames += sum(
+                    model.interpolated_frames(b.measured) for b in batch
+                )
                 advance(len(batch))
                 batch = []
 
