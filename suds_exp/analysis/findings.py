@@ -551,17 +551,13 @@ def findings_table(
     data = _draw_frame(results, upper_from)
     name = campaign if campaign is not None else str(results["campaign"].iloc[0])
     rng = np.random.default_rng(_seed(name, seed))
-    strata = _strata(data)
-    replicates = []
-    for _ in range(n_boot):
-        idx = np.concatenate([s[rng.integers(len(s), size=len(s))] for s in strata])
-        replicates.append(data.take(idx))
     alpha = (1 - confidence) / 2
-    rows = []
     # One BLAS thread for the GLM fits: the matrices are small (see `glm`); set once, as
     # finding the BLAS libraries costs more than a fit.
-    with threadpool_limits(limits=1, user_api="blas"):
-        rows = [_measure(f, data, replicates, alpha) for f in FINDINGS]
+    with threadpool_limits(limits=1, user_api="blas"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        values, boots, reasons = _bootstrap(data, rng, n_boot)
+    rows = [_row(f, values.get(f.id), boots.get(f.id), reasons.get(f.id), alpha) for f in FINDINGS]
     table = pd.DataFrame(rows)
     table["holds"] = table["holds"].astype("boolean")
     table.attrs = {
@@ -575,8 +571,39 @@ def findings_table(
     return table
 
 
-def _measure(f: Finding, data: _Data, replicates: list[_Data], alpha: float) -> dict:
-    """One row of the findings table: ``f`` on the data and on every replicate."""
+def _bootstrap(
+    data: _Data, rng: np.random.Generator, n_boot: int
+) -> tuple[dict[str, float], dict[str, list[float]], dict[str, str]]:
+    """Every finding's statistic on the data and on ``n_boot`` replicates (resampled
+    within strata), one replicate in memory at a time: (value by id, replicate values by
+    id, why not measurable by id). A statistic not measurable on the data or on any
+    replicate is not measurable."""
+    values: dict[str, float] = {}
+    reasons: dict[str, str] = {}
+    for f in FINDINGS:
+        try:
+            values[f.id] = f.compute(data)
+        except NotMeasurable as exc:
+            reasons[f.id] = str(exc)
+    boots: dict[str, list[float]] = {i: [] for i in values}
+    strata = _strata(data)
+    for _ in range(n_boot):
+        idx = np.concatenate([s[rng.integers(len(s), size=len(s))] for s in strata])
+        replicate = data.take(idx)
+        for f in FINDINGS:
+            if f.id in reasons:
+                continue
+            try:
+                boots[f.id].append(f.compute(replicate))
+            except NotMeasurable as exc:
+                reasons[f.id] = str(exc)
+    return values, boots, reasons
+
+
+def _row(
+    f: Finding, value: float | None, boots: list[float] | None, reason: str | None, alpha: float
+) -> dict:
+    """One row of the findings table from ``f``'s value and replicate values."""
     row = {
         "id": f.id,
         "finding": f.finding,
@@ -590,14 +617,10 @@ def _measure(f: Finding, data: _Data, replicates: list[_Data], alpha: float) -> 
         "holds": pd.NA,
         "reason": "",
     }
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            value = f.compute(data)
-            boots = np.array([f.compute(r) for r in replicates], dtype=float)
-    except NotMeasurable as exc:
-        row["reason"] = str(exc)
+    if reason is not None:
+        row["reason"] = reason
         return row
+    boots = np.asarray(boots, dtype=float)
     boots = boots[np.isfinite(boots)]
     low, high = np.quantile(boots, [alpha, 1 - alpha]) if len(boots) else (np.nan, np.nan)
     verdict = _verdict(f, value, low, high)
