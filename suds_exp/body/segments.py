@@ -40,8 +40,8 @@ Per trial, from the cleaned markers:
 
 Written as such a description (`suds_exp/body/swimmer.toml`), the swimmer gives the same
 numbers as the built-in pipeline with the segment-frame settings (``tail_fit=rigid``,
-``body_fit=segments``) on trials that lose no tail frame marker; the built-in default's chain fit and flipper circles use facts
-of that one robot and are not generic.
+``body_fit=segments``) on trials that lose no tail frame marker; the built-in default's
+chain fit and flipper circles use facts of that one robot and are not generic.
 """
 
 from __future__ import annotations
