@@ -38,8 +38,8 @@ QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress ba
 
 def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None = None, **kwargs):
     """`app.command` (or ``on``'s, a sub-app) that turns a `SudsError` into one line on
-    stderr and exit code 2; ``flags`` maps this command's library parameters to flags
-    where `flag` would not."""
+    stderr and its exit code (2; 3 for a lost cluster); ``flags`` maps this command's
+    library parameters to flags where `flag` would not."""
 
     def wrap(fn):
         @functools.wraps(fn)
@@ -50,7 +50,7 @@ def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None =
                 console.err.print(
                     f"[red]error:[/red] {user_message(exc, flags)}", markup=True, highlight=False
                 )
-                raise typer.Exit(2) from None
+                raise typer.Exit(exc.exit_code) from None
             except OSError as exc:
                 # a file-system error the library did not foresee (disk full while a
                 # report is written...): its path and reason, not a traceback

@@ -2,7 +2,8 @@
 
 Every error a user can cause (bad file, bad option, bad manifest) is raised as a
 `SudsError` subclass whose message is one line naming the file/row/option and what was
-expected; the CLI prints it and exits with status 2 without a traceback.
+expected; the CLI prints it and exits with its ``exit_code`` (2, or 3 for a lost
+cluster) without a traceback.
 """
 
 
@@ -27,6 +28,9 @@ class SudsError(Exception):
         self.param = param
         self.step = step
 
+    #: The command line's exit status for this error.
+    exit_code = 2
+
 
 class IngestError(SudsError):
     """A capture file, manifest or marker layout cannot be ingested as given."""
@@ -50,6 +54,14 @@ class ModelError(SudsError):
 
 class CampaignError(SudsError):
     """A campaign cannot be created, continued or run as asked."""
+
+
+class ClusterLostError(CampaignError):
+    """The dask cluster went away during a run (scheduler killed, network gone): what was
+    finished is stored and the same command resumes. Exit status 3, so a script can tell
+    it from a refused input."""
+
+    exit_code = 3
 
 
 class AnalysisError(SudsError):

@@ -15,6 +15,7 @@ write-ahead log makes each batch all-or-nothing.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import dataclasses
 import json
@@ -50,7 +51,7 @@ from suds_exp.campaign.grid import enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
-from suds_exp.errors import CampaignError, StoreError
+from suds_exp.errors import CampaignError, ClusterLostError, StoreError
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 from suds_exp.store.definition import check_same
@@ -450,6 +451,9 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
         from dask.distributed import Client, LocalCluster
 
         if scheduler:
+            # a lost scheduler is one line (`ClusterLostError`), not the client's logged
+            # reconnect tracebacks
+            stack.enter_context(_quiet_logger("distributed"))
             stack.enter_context(Client(scheduler, timeout=SCHEDULER_WAIT_S))
         else:
             with _sigint_blocked():
@@ -478,6 +482,32 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
         )
     stack.callback(getattr(gen, "close", lambda: None))
     return gen
+
+
+@contextlib.contextmanager
+def _quiet_logger(name: str) -> Iterator[None]:
+    """Only critical records of logger ``name`` and its children (dask's config gives some
+    of them levels of their own) while inside."""
+    names = [name] + [n for n in logging.root.manager.loggerDict if n.startswith(name + ".")]
+    loggers = [logging.getLogger(n) for n in names]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)
+
+
+def _cluster_lost(exc: BaseException) -> bool:
+    """True for what a dask client raises when its scheduler or the connection to it goes
+    away mid-run (a closed comm, cancelled futures, a reconnect that timed out)."""
+    from concurrent.futures import CancelledError
+
+    from distributed.comm.core import CommClosedError
+
+    return isinstance(exc, CommClosedError | CancelledError | asyncio.CancelledError | TimeoutError)
 
 
 BANK_PREFIX = "suds_bank_"
@@ -574,6 +604,7 @@ def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
         if how.on_batch is not None:
             how.on_batch(len(frame))
 
+    lost: BaseException | None = None
     with (
         _Signals() as signals,
         progress_bar(
@@ -604,6 +635,10 @@ def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
                         last = time.monotonic()
         except KeyboardInterrupt:
             summary.interrupted = True
+        except (Exception, asyncio.CancelledError) as exc:
+            if how.backend != "dask" or not _cluster_lost(exc):
+                raise
+            lost = exc
         finally:
             # Rows already received are written even when stopping or failing: a stop
             # loses no finished work. A second Ctrl-C during this write is served after it.
@@ -611,3 +646,12 @@ def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
                 flush(final=True)
             except KeyboardInterrupt:
                 summary.interrupted = True
+    if lost is not None:
+        where, again = "the local dask cluster", ""
+        if how.scheduler:
+            where, again = how.scheduler, "start the scheduler and its workers again, then "
+        raise ClusterLostError(
+            f"dask cluster lost during campaign {plan.name!r} ({where}: "
+            f"{type(lost).__name__}); the {summary.done_before + summary.done_now} finished "
+            f"jobs are stored; {again}run the same command to continue"
+        ) from None
