@@ -59,7 +59,8 @@ lint: $(STAMP)
 lint-imports: $(STAMP)
 	$(BIN)/lint-imports
 
-# The documentation site (mkdocs.yml) into site/, warnings as errors; needs the docs extra.
+# The documentation site (mkdocs.yml) into site/, warnings as errors, then every local link
+# checked as a reader opening the files would follow it; needs the docs extra.
 DOCS_STAMP := $(VENV)/.docs-installed
 $(DOCS_STAMP): $(STAMP)
 	$(INSTALL) -e '.[dev,docs]'
@@ -67,6 +68,7 @@ $(DOCS_STAMP): $(STAMP)
 
 docs: $(DOCS_STAMP)
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+	$(BIN)/python docs/hooks/check_site.py site
 
 # build the sdist and wheel, install the wheel in a fresh venv outside the checkout and run
 # a short quickstart from an empty folder (.ci/wheel_check.sh; run by .ci/run)

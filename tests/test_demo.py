@@ -11,6 +11,8 @@ from typer.testing import CliRunner
 from cli import app
 from suds_exp.store import Store
 
+README = Path(__file__).resolve().parents[1] / "README.md"
+
 runner = CliRunner()
 
 
@@ -42,3 +44,20 @@ def test_demo_runs_end_to_end_and_is_idempotent(tmp_path, monkeypatch):
     assert "reports/demo/index.html and reports/discrepancy-demo/index.html" in again.stdout
     assert store.query_df("SELECT count(*) AS n FROM trials").n[0] == 60
     assert store.query_df("SELECT count(*) AS n FROM results").n[0] == summary["n_results"]
+
+
+def readme_python() -> str:
+    """The README's "From Python" block."""
+    text = README.read_text()
+    section = text[text.index("## From Python") :]
+    return section.split("```python\n", 1)[1].split("```", 1)[0]
+
+
+@pytest.mark.slow
+def test_the_readme_python_snippet_runs_after_the_demo(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert runner.invoke(app, ["demo", "-q"]).exit_code == 0
+    namespace: dict = {}
+    exec(compile(readme_python(), "README.md (From Python)", "exec"), namespace)
+    assert len(namespace["pred"]) == int((namespace["samples"].trial_id == 1).sum())
+    assert not namespace["glm"].empty

@@ -79,3 +79,25 @@ def test_a_fit_pinned_at_either_edge_of_its_realistic_range_is_at_the_edge():
     assert not _fitted(189.5).at_range_edge
     assert not _fitted(58.06, bounds=(0.0, 60.0)).at_range_edge
     assert not _fitted(None, param=None).at_range_edge
+
+
+def test_a_named_effect_prints_rounded(capsys):
+    from types import SimpleNamespace
+
+    from suds_exp.commands.discrepancy import print_discrepancy
+
+    named = {
+        "step": 0,
+        "candidate": "body_inertia",
+        "parameter": "tau_s",
+        "value": 0.302375,
+        "unit": "s",
+        "ci": [0.293375, 0.31187499999999996],
+        "p_adjusted": 7.1e-37,
+        "gap_before": 1.346,
+        "gap_after": 0.00175,
+    }
+    result = SimpleNamespace(named=[named], discovery=None, outcome="named", report_dir="r")
+    print_discrepancy(result)
+    out = capsys.readouterr().out
+    assert "tau_s = 0.3024 s [0.2934, 0.3119] (p_adj 7.1e-37)" in out, out

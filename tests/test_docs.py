@@ -143,3 +143,26 @@ def test_every_table_view_and_parameter_is_in_the_reference(tmp_path, monkeypatc
     params = gen.preprocessing_parameters()
     for key in DEFAULTS:
         assert f"| `{key}` |" in params, key
+
+
+def test_the_site_check_finds_folder_links_missing_files_and_orphans(tmp_path):
+    """`docs/hooks/check_site.py` (run by `make docs` on the built site) flags what a
+    reader opening the files would hit."""
+    import importlib.util
+
+    path = DOCS / "hooks" / "check_site.py"
+    spec = importlib.util.spec_from_file_location("check_site", path)
+    check_site = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(check_site)
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "index.html").write_text(
+        '<a href="sub/">x</a><a href="gone.html#a">y</a><a href="ok.html">z</a>'
+        '<img src="data:image/png;base64,AA"><a href="https://example.org/">w</a>'
+    )
+    (tmp_path / "ok.html").write_text('<a href="index.html">back</a><a href="#top">top</a>')
+    (tmp_path / "orphan.html").write_text("<p>alone</p>")
+    assert check_site.check(tmp_path) == [
+        "index.html: sub/ -> a folder",
+        "index.html: gone.html#a -> missing",
+        "orphan.html: not reached from index.html",
+    ]

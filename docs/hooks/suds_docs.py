@@ -12,6 +12,10 @@ so the reference cannot drift from what the package does:
 - ``simulator-effects``: `suds_exp.sim.effect_library()`;
 - ``cli``: every command of the typer app ``cli:app``, by typer's own documentation
   generator (``typer cli utils docs``), the same text ``--help`` prints.
+
+It also renders display math, ``$$ TeX $$``, to inline SVG with matplotlib's mathtext
+at build time, so equations show on a site opened from files, with no script and no
+network (a MathJax page needs both).
 """
 
 from __future__ import annotations
@@ -40,7 +44,35 @@ def on_page_markdown(markdown, page, config, files):
             raise KeyError(f"{page.file.src_path}: no generator named {name!r}")
         return GENERATORS[name]()
 
-    return MARKER.sub(render, markdown)
+    return DISPLAY_MATH.sub(math_image, MARKER.sub(render, markdown))
+
+
+# --- math ------------------------------------------------------------------------------
+
+DISPLAY_MATH = re.compile(r"\$\$(.+?)\$\$", re.DOTALL)
+
+
+def math_image(match: re.Match) -> str:
+    """``$$ TeX $$`` as an ``<img>`` of its SVG (matplotlib mathtext: sums, sub- and
+    superscripts, accents and spacing; TeX beyond that fails the build, by design)."""
+    import base64
+    import html
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import mathtext
+
+    tex = " ".join(match.group(1).split())
+    buf = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": "suds-docs", "svg.fonttype": "path"}):
+        mathtext.math_to_image(f"${tex}$", buf, format="svg", dpi=110)
+    data = base64.b64encode(buf.getvalue()).decode()
+    return (
+        f'<img class="math" alt="{html.escape(tex)}" '
+        f'src="data:image/svg+xml;base64,{data}">'
+    )
 
 
 # --- database --------------------------------------------------------------------------

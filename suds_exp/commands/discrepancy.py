@@ -79,12 +79,18 @@ def discrepancy_options(
     )
 
 
+def _num(value) -> str:
+    """A fitted value to 4 significant digits (text, such as a level name, as it is)."""
+    return f"{value:.4g}" if isinstance(value, int | float) else str(value)
+
+
 def print_discrepancy(result: DiscrepancyResult) -> None:
     """One line per named effect and learned term, the outcome and the report folder."""
     for n in result.named:
+        ci = "[" + ", ".join(f"{v:.4g}" for v in n["ci"]) + "]" if n["ci"] else ""
         console.out.print(
-            f"step {n['step']}: {n['candidate']} {n['parameter'] or ''} = {n['value']} "
-            f"{n['unit']} {n['ci']} (p_adj {n['p_adjusted']:.2g}); "
+            f"step {n['step']}: {n['candidate']} {n['parameter'] or ''} = {_num(n['value'])} "
+            f"{n['unit']} {ci} (p_adj {n['p_adjusted']:.2g}); "
             f"held-out loss {n['gap_before']:.4g} -> {n['gap_after']:.4g}"
         )
     if result.discovery is not None:
