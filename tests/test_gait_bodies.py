@@ -259,3 +259,14 @@ def test_every_estimate_lies_inside_its_interval_or_says_why(body_db, tmp_path):
     text = ok(*args)
     for key in doc["interval_notes"]:
         assert f"note: {key}: estimate" in text, text
+
+
+def test_the_simulator_refuses_a_gait_of_other_joints_in_one_line(tmp_path, db):
+    # the simulator moves the swimmer: a gait file of other joints is refused before any
+    # file is written
+    assert cli("init", "--db", db).exit_code == 0
+    gait = wave_toml(tmp_path / "q.toml", ["q1", "q2"])
+    out = tmp_path / "sim"
+    line = refused(db, "simulate", "--out", out, "--gait-file", gait, "--ingest")
+    assert "q.toml" in line and "'q1', 'q2'" in line and "phi1, phi2" in line, line
+    assert not out.exists()

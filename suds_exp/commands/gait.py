@@ -12,7 +12,7 @@ from suds_exp.gait.design import Design, DesignOptions, design_gait
 from suds_exp.gait.joints import describe, is_swimmer, match_joints, version_joints
 from suds_exp.gait.plots import draw_connection, draw_design
 from suds_exp.gait.predict import decimate, fit_map, predict_gait
-from suds_exp.gait.shape import JOINT_LIMIT_RAD, read_gait_file
+from suds_exp.gait.shape import JOINT_LIMIT_RAD, SWIMMER_JOINTS, read_gait_file
 from suds_exp.gait.trials import simulate_gait_file
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
@@ -196,8 +196,10 @@ def connection_command(
 
 
 def simulate_file_command(out: Path, gait_file: Path, config=None, **kwargs) -> dict:
-    """`simulate --gait-file`: trials of the gait file (see `simulate_gait_file`)."""
-    return simulate_gait_file(out, read_gait_file(gait_file), config, **kwargs)
+    """`simulate --gait-file`: trials of the gait file (see `simulate_gait_file`); the
+    simulator moves the swimmer, so the file's columns must be its joints phi1, phi2."""
+    gait = match_joints(read_gait_file(gait_file), SWIMMER_JOINTS, f"{gait_file}: simulator")
+    return simulate_gait_file(out, gait, config, **kwargs)
 
 
 def predict_text(doc: dict, learner: str) -> str:
