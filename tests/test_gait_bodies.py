@@ -207,6 +207,9 @@ def test_connection_of_a_two_joint_body_goes_under_reports(body_db, tmp_path, mo
     assert doc["joints"] == ["q1", "q2"] and doc["n_inside"] > 0
     line = refused(body_db, *args[:-2], "--compare")
     assert "--compare" in line and "swimmer" in line, line
+    # a grid with no shape near the data (5 points over +-2 rad; the data swing 0.5 rad)
+    line = refused(body_db, "gait", "connection", "--grid", "5")
+    assert "--grid 5, --range 2: no shape of the grid lies within 0.1 rad" in line, line
 
 
 @pytest.mark.parametrize("body_db", [1, 4], indirect=True, ids=["1-joint", "4-joint"])

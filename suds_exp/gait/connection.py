@@ -145,8 +145,8 @@ def learned_connection(
         if not inside.any():
             # no shape to fit from: say so rather than ask the learner about nothing
             raise ConfigError(
-                f"no shape of the {grid} x {grid} grid over +-{half_range:g} rad lies within "
-                f"{radius:g} rad of the data; give a finer grid or a narrower half_range",
+                f"grid {grid}, half_range {half_range:g}: no shape of the grid lies within "
+                f"{radius:g} rad of the data; make it finer or narrower",
                 param=("grid", "half_range"),
             )
         dirs = _visited_directions(samples, rate, norm, pts, inside.ravel(), radius, seed)
