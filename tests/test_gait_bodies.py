@@ -243,6 +243,11 @@ def test_design_works_on_any_body_and_writes_under_reports(body_db, tmp_path, mo
     # the designed gait's file reads back as a gait of the body's joints
     saved = Path(doc["gaits"][0])
     assert read_gait_file(saved).joints == tuple(doc["joints"])
+    # the same design printed: its line flags a gait outside the data's support
+    text = ok(
+        "gait", "design", "--iterations", "1", "--order", "1", "--bound", "0.8", "--db", body_db
+    )
+    assert ("outside the data's support" in text) is (not it["support"]["inside"]), text
     line = refused(body_db, "gait", "design", "--iterations", "1", "--verify")
     assert "--verify" in line and "swimmer" in line, line
 

@@ -233,11 +233,18 @@ def predict_text(doc: dict, learner: str) -> str:
 
 
 def iteration_text(it) -> str:
-    """The line `gait design` prints for each iteration as it is stored."""
+    """The line `gait design` prints for each iteration as it is stored, flagging a gait
+    outside the data's support (the trust radius may let the search go beyond it)."""
     ach = f", achieved {it.achieved.forward_mm:.1f}" if it.achieved else ""
+    outside = ""
+    if not it.support.get("inside", True):
+        outside = (
+            f"; outside the data's support (distance {it.support_distance:.3f} rad > "
+            f"{it.support['radius_rad']:g} rad): the prediction extrapolates"
+        )
     return (
         f"iteration {it.iteration}: predicted {it.predicted.forward_mm:.1f} mm/cycle"
-        f"{ach}; trust radius {it.trust_radius:.3f} ({it.seconds:.0f} s)"
+        f"{ach}; trust radius {it.trust_radius:.3f} ({it.seconds:.0f} s){outside}"
     )
 
 
