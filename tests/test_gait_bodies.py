@@ -215,21 +215,8 @@ def test_connection_of_a_two_joint_body_goes_under_reports(body_db, tmp_path, mo
 @pytest.mark.parametrize("body_db", [1, 4], indirect=True, ids=["1-joint", "4-joint"])
 def test_design_works_on_any_body_and_writes_under_reports(body_db, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    doc = json.loads(
-        ok(
-            "gait",
-            "design",
-            "--iterations",
-            "1",
-            "--order",
-            "1",
-            "--bound",
-            "0.8",
-            "--db",
-            body_db,
-            "--json",
-        )
-    )
+    args = ("gait", "design", "--iterations", "1", "--order", "1", "--bound", "0.8")
+    doc = json.loads(ok(*args, "--db", body_db, "--json"))
     report = Path(doc["report"])
     assert report.is_file() and report.resolve().is_relative_to((tmp_path / "reports").resolve())
     assert not (tmp_path / "gait-design").exists()

@@ -23,6 +23,16 @@ def _pyplot():
     return plt
 
 
+def _save(plt, fig, path: str | Path) -> Path:
+    """Lay out, write ``fig`` as a PNG at ``path`` (its folder made), close it."""
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
 def _panel(ax, phi1, phi2, A, curl, inside, gaits, title, unit, labels=None):
     p1, p2 = np.meshgrid(phi1, phi2, indexing="ij")
     lim = np.nanmax(np.abs(curl)) if np.isfinite(curl).any() else 1.0
@@ -78,12 +88,7 @@ def draw_connection(
             fig.colorbar(mesh, ax=axes[r, c], shrink=0.8)
     if gaits:
         axes[0, 0].legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def draw_design(design, learned: LearnedConnection | None, path: str | Path) -> Path:
@@ -105,12 +110,7 @@ def draw_design(design, learned: LearnedConnection | None, path: str | Path) -> 
     else:
         _height_panel(fig, axes[0], design, learned)
     _displacement_panels(axes[1], axes[2], design)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def _height_panel(fig, ax, design, learned: LearnedConnection) -> None:

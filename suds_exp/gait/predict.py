@@ -293,7 +293,8 @@ class Interval:
 
 def percentile_interval(estimate: float, boots: np.ndarray, level: float = 0.95) -> Interval:
     """The percentile interval of ``boots`` (B,) refits at ``level`` around ``estimate``
-    (the fit on all trials), with B >= `MIN_BOOT` (ConfigError otherwise).
+    (the fit on all trials), with B >= `MIN_BOOT` at 95 % and one refit beyond each tail
+    at any level (ConfigError otherwise).
 
     The interval is the refits' spread, not centred on the estimate by construction: when
     resampling trials shifts the refits (bootstrap bias: a resample holds about 63 % of
@@ -302,14 +303,15 @@ def percentile_interval(estimate: float, boots: np.ndarray, level: float = 0.95)
     the bias (mean of refits - estimate) rather than moved or widened to include it.
     """
     boots = np.asarray(boots, float)
-    if len(boots) < MIN_BOOT:
+    tail = 50 * (1 - level)
+    needed = max(MIN_BOOT, math.ceil(100 / tail - 1e-9))  # one refit beyond each tail
+    if len(boots) < needed:
         raise ConfigError(
             f"n_boot {len(boots)}: a {100 * level:g} % percentile interval needs at least "
-            f"{MIN_BOOT} refits (one beyond each {50 * (1 - level):g} % tail); give 0 for "
-            f"no interval or {MIN_BOOT} or more",
+            f"{needed} refits (one beyond each {tail:g} % tail); give 0 for no interval or "
+            f"{needed} or more",
             param="n_boot",
         )
-    tail = 50 * (1 - level)
     low, high = (float(v) for v in np.percentile(boots, [tail, 100 - tail]))
     if low <= estimate <= high:
         return Interval(low, high)
