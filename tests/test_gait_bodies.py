@@ -265,3 +265,42 @@ def test_the_simulator_refuses_a_gait_of_other_joints_in_one_line(tmp_path, db):
     line = refused(db, "simulate", "--out", out, "--gait-file", gait, "--ingest")
     assert "q.toml" in line and "'q1', 'q2'" in line and "phi1, phi2" in line, line
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_predict_and_design_on_eight_actuated_joints(tmp_path, monkeypatch):
+    # the most a version holds (ra_1 .. ra_8): a 9-link body (24 s measured in all)
+    db = _body_db(tmp_path, 9, {})
+    joints = joints_of(8)
+    doc = json.loads(
+        ok(
+            "gait",
+            "predict",
+            "--gait-file",
+            wave_toml(tmp_path / "w.toml", joints),
+            "--boot",
+            "0",
+            "--db",
+            db,
+            "--json",
+        )
+    )
+    assert doc["joints"] == joints and doc["support"]["inside"] is True
+    monkeypatch.chdir(tmp_path)
+    design = json.loads(
+        ok(
+            "gait",
+            "design",
+            "--iterations",
+            "1",
+            "--order",
+            "1",
+            "--bound",
+            "0.8",
+            "--db",
+            db,
+            "--json",
+        )
+    )
+    assert design["joints"] == joints
+    assert read_gait_file(design["gaits"][0]).joints == tuple(joints)
