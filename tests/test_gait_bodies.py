@@ -304,3 +304,7 @@ def test_predict_and_design_on_eight_actuated_joints(tmp_path, monkeypatch):
     )
     assert design["joints"] == joints
     assert read_gait_file(design["gaits"][0]).joints == tuple(joints)
+    # the designer's circles are far from these data in 16 dimensions; the design still
+    # keeps to its trust region
+    it = design["iterations"][0]
+    assert it["support_distance"] <= it["trust_radius"] + 1e-9, it

@@ -27,7 +27,8 @@ Every iteration is stored in ``gait_design_iterations`` (migration 017).
 The optimiser is Nelder-Mead with penalties (a fitted map is cheap, a few ms a gait, but
 not smooth enough for gradients), started from the best gait so far and from the paper's
 circle O, plain and tilted either way (`LAGS_RAD`); on a body of m joints the circle is
-the travelling wave it generalises (`circle`).
+the travelling wave it generalises (`circle`). When none of these fits the trust region,
+the search also starts from the data's mean path (`data_gait`).
 
 ``verify`` runs the swimmer simulator, so only a swimmer's version can be verified; any
 other body is refused in one line before anything is stored.
@@ -242,6 +243,19 @@ def _circle_starts(opts: DesignOptions, joints: tuple[str, ...]) -> list[Fourier
     return [circle(r, opts.order, lag=d, joints=joints) for r in radii for d in lags]
 
 
+def data_gait(samples: pd.DataFrame, order: int, joints: tuple[str, ...]) -> FourierGait:
+    """The training data's mean path: each joint's angle (rad) fitted by least squares on
+    the samples' phase (rad) with ``order`` harmonics, as a gait of ``joints``."""
+    theta = samples["phase"].to_numpy(float)
+    n = np.arange(1, order + 1)
+    basis = np.hstack(
+        [np.ones((len(theta), 1)), np.cos(theta[:, None] * n), np.sin(theta[:, None] * n)]
+    )
+    ra = samples[[f"ra_{j + 1}" for j in range(len(joints))]].to_numpy(float)
+    coef = np.linalg.lstsq(basis, ra, rcond=None)[0]  # (1 + 2 order, m)
+    return FourierGait(coef[0], coef[1 : 1 + order], coef[1 + order :], "data", joints)
+
+
 def _fit_inside(gait: FourierGait, support: Support, bound: float, trust: float) -> FourierGait:
     """The start shrunk towards its centre until it is inside bound and trust region."""
     for scale in np.linspace(1.0, 0.3, 15):
@@ -299,6 +313,12 @@ def design_gait(
             _fit_inside(g, support, opts.bound, trust)
             for g in (best, *_circle_starts(opts, joints))
         ]
+        if all(support.gait_distance(g) > trust for g in starts):
+            # no circle fits the trust region (on a body of many joints whose data are not
+            # circles): start too from the data's own mean path, inside it by construction
+            starts.append(
+                _fit_inside(data_gait(samples, opts.order, joints), support, opts.bound, trust)
+            )
         gait, _ = optimise_gait(
             lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
             support,
