@@ -24,6 +24,8 @@ from tests.conftest import assert_same_db, dump_db
 
 runner = CliRunner()
 
+#: One design iteration of one harmonic a joint within 0.8 rad.
+DESIGN_ONE = ("gait", "design", "--iterations", "1", "--order", "1", "--bound", "0.8")
 #: The generator's travelling wave (`kinematic_body.travelling_wave` defaults): actuated
 #: joint i at AMPLITUDE sin(theta - i LAG).
 AMPLITUDE, LAG = 0.5, 0.9
@@ -215,8 +217,7 @@ def test_connection_of_a_two_joint_body_goes_under_reports(body_db, tmp_path, mo
 @pytest.mark.parametrize("body_db", [1, 4], indirect=True, ids=["1-joint", "4-joint"])
 def test_design_works_on_any_body_and_writes_under_reports(body_db, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    args = ("gait", "design", "--iterations", "1", "--order", "1", "--bound", "0.8")
-    doc = json.loads(ok(*args, "--db", body_db, "--json"))
+    doc = json.loads(ok(*DESIGN_ONE, "--db", body_db, "--json"))
     report = Path(doc["report"])
     assert report.is_file() and report.resolve().is_relative_to((tmp_path / "reports").resolve())
     assert not (tmp_path / "gait-design").exists()
@@ -287,21 +288,7 @@ def test_predict_and_design_on_eight_actuated_joints(tmp_path, monkeypatch):
     )
     assert doc["joints"] == joints and doc["support"]["inside"] is True
     monkeypatch.chdir(tmp_path)
-    design = json.loads(
-        ok(
-            "gait",
-            "design",
-            "--iterations",
-            "1",
-            "--order",
-            "1",
-            "--bound",
-            "0.8",
-            "--db",
-            db,
-            "--json",
-        )
-    )
+    design = json.loads(ok(*DESIGN_ONE, "--db", db, "--json"))
     assert design["joints"] == joints
     assert read_gait_file(design["gaits"][0]).joints == tuple(joints)
     # the designer's circles are far from these data in 16 dimensions; the design still
