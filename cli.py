@@ -692,20 +692,26 @@ LearnerOption = Annotated[str, typer.Option(help="Learner name (see suds_exp.mod
 
 @command(on=gait_app, name="predict", flags={"frequency_hz": "--freq", "n_boot": "--boot"})
 def gait_predict(
-    gait_file: Annotated[Path, typer.Option(help="CSV phase_rad,phi1_rad,phi2_rad or TOML.")],
+    gait_file: Annotated[
+        Path,
+        typer.Option(help="CSV phase_rad,<joint>_rad,... or TOML; one column per actuated joint."),
+    ],
     freq: Annotated[str, typer.Option(help="Gait frequency, Hz (e.g. 1/2).")] = "0.5",
     prep: PrepOption = None,
     learner: LearnerOption = "GMR",
     trials_: Annotated[
         str | None, typer.Option("--trials", help="Training trial ids (default: all).")
     ] = None,
-    boot: Annotated[int, typer.Option(help="Bootstrap refits for the intervals.")] = 10,
+    boot: Annotated[
+        int, typer.Option(help="Bootstrap refits for the 95 % intervals: 0 (none) or 40+.")
+    ] = 40,
     bound: Annotated[float, typer.Option(help="Joint bound the gait must keep, rad.")] = 2.0,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
     """Predict a gait's net motion per cycle (forward_mm, lateral_mm, turn_rad, mean_vx_mm_s)
-    from a learner fitted on the version's trials, by the SE(2) path-ordered integral.
+    from a learner fitted on the version's trials, by the SE(2) path-ordered integral;
+    warns when the gait leaves the data's support.
 
     Example: suds-exp gait predict --gait-file ellipse.toml --freq 1/2 --learner GMR --json
     """
@@ -725,7 +731,7 @@ def gait_predict(
 
 @command(on=gait_app, name="design", flags={"frequency_hz": "--freq"})
 def gait_design(
-    bound: Annotated[float, typer.Option(help="Joint bound |phi1|, |phi2| <= RAD.")] = 1.3,
+    bound: Annotated[float, typer.Option(help="Joint bound |angle| <= RAD, every joint.")] = 1.3,
     iterations: Annotated[int, typer.Option(help="Design iterations.")] = 5,
     verify: Annotated[
         bool, typer.Option("--verify", help="Run each design on the simulator and learn it.")
@@ -734,9 +740,9 @@ def gait_design(
     learner: LearnerOption = "GMR",
     freq: Annotated[str, typer.Option(help="Gait frequency, Hz.")] = "0.5",
     order: Annotated[int, typer.Option(help="Fourier harmonics per joint.")] = 2,
-    out: Annotated[Path, typer.Option(help="Folder for verify trials and the report.")] = Path(
-        "gait-design"
-    ),
+    out: Annotated[
+        Path, typer.Option(help="Folder for verify trials, designed gaits and the report.")
+    ] = Path("reports/gait-design"),
     config: SimConfigOption = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -772,7 +778,9 @@ def gait_design(
 
 @command(on=gait_app, name="connection", flags={"half_range": "--range"})
 def gait_connection(
-    out: Annotated[Path, typer.Option(help="CSV file; the figure goes beside it (.png).")],
+    out: Annotated[Path, typer.Option(help="CSV file; the figure goes beside it (.png).")] = Path(
+        "reports/gait-connection/learned.csv"
+    ),
     prep: PrepOption = None,
     learner: LearnerOption = "GMR",
     grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,

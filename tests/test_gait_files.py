@@ -103,9 +103,16 @@ def test_the_bound_is_a_parameter(tmp_path):
 
 def test_toml_errors_name_the_file(tmp_path):
     p = tmp_path / "g.toml"
-    p.write_text("[phi1]\ncos = [1.0]\n")
-    with pytest.raises(ConfigError, match=r"g.toml: expected tables \[phi1\] and \[phi2\]"):
+    # one table a joint: a file of [phi1] alone is a one-joint gait (issue 39); a loose
+    # value where a joint's table belongs is refused
+    p.write_text("phi1 = 1.0\n[phi2]\nsin = [1.0]\n")
+    with pytest.raises(ConfigError, match=r"g.toml: entry 'phi1' is not a table; expected one"):
         read_gait_file(p)
+    p.write_text('name = "x"\n')
+    with pytest.raises(ConfigError, match=r"g.toml: no joint; expected one table a joint"):
+        read_gait_file(p)
+    p.write_text("[phi1]\ncos = [1.0]\n")
+    assert read_gait_file(p).joints == ("phi1",)
     p.write_text("[phi1]\ncos = ['a']\n[phi2]\nsin = [1.0]\n")
     with pytest.raises(ConfigError, match="lists of numbers"):
         read_gait_file(p)

@@ -34,7 +34,7 @@ import pandas as pd
 from scipy.spatial import cKDTree
 
 from suds_exp.errors import ConfigError
-from suds_exp.gait.support import SHAPE_RADIUS, Support
+from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns
 
 COMPONENTS = ("vx", "vy", "wz")
 #: Most visited directions a shape's fit uses (``directions="visited"``).
@@ -134,7 +134,7 @@ def learned_connection(
     pts = np.column_stack([p1.ravel(), p2.ravel()])
     support = Support.of(samples)
     inside = support.inside(pts, radius).reshape(grid, grid)
-    rate = samples[["dra_1", "dra_2"]].to_numpy(float)
+    rate = samples[actuated_columns(samples)[1]].to_numpy(float)
     norm = np.linalg.norm(rate, axis=1)
     speed = float(np.median(norm))
     if directions == "uniform":
@@ -142,6 +142,13 @@ def learned_connection(
         uniform = np.column_stack([np.cos(b), np.sin(b)])
         dirs = [uniform] * len(pts)
     else:
+        if not inside.any():
+            # no shape to fit from: say so rather than ask the learner about nothing
+            raise ConfigError(
+                f"grid {grid}, half_range {half_range:g}: no shape of the grid lies within "
+                f"{radius:g} rad of the data; make it finer or narrower",
+                param=("grid", "half_range"),
+            )
         dirs = _visited_directions(samples, rate, norm, pts, inside.ravel(), radius, seed)
     counts = np.array([len(d) for d in dirs])
     ra = np.repeat(pts, counts, axis=0)
@@ -188,7 +195,7 @@ def _visited_directions(samples, rate, norm, pts, inside, radius, seed) -> list[
     (m, 2) of the training samples within ``radius`` rad of it (at most `MAX_VISITED`,
     drawn with ``seed``); an empty (0, 2) array outside."""
     moving = norm > 1e-6
-    shapes = samples[["ra_1", "ra_2"]].to_numpy(float)[moving]
+    shapes = samples[actuated_columns(samples)[0]].to_numpy(float)[moving]
     unit = rate[moving] / norm[moving, None]
     tree = cKDTree(shapes)
     rng = np.random.default_rng(seed)

@@ -1,10 +1,10 @@
 """Design a gait from a learned motility map, and verify it: the data-driven loop.
 
 Each iteration fits the learner on the version's samples, then maximises the predicted
-forward displacement per cycle over the Fourier coefficients of both joints (order
-``order``) subject to
+forward displacement per cycle over the Fourier coefficients of every actuated joint of
+the version's body (1 to 8; order ``order``) subject to
 
-- the joint bound: |phi1|, |phi2| <= bound (rad), and
+- the joint bound: |angle| <= bound (rad) at every joint, and
 - the trust region: the gait's distance from the training data in the
   (shape, direction of shape velocity) metric of `suds_exp.gait.support` is at most the
   trust radius. A learned map interpolates; far from its data it guesses. The radius
@@ -26,7 +26,12 @@ Every iteration is stored in ``gait_design_iterations`` (migration 017).
 
 The optimiser is Nelder-Mead with penalties (a fitted map is cheap, a few ms a gait, but
 not smooth enough for gradients), started from the best gait so far and from the paper's
-circle O, plain and tilted either way (`LAGS_RAD`).
+circle O, plain and tilted either way (`LAGS_RAD`); on a body of m joints the circle is
+the travelling wave it generalises (`circle`). When none of these fits the trust region,
+the search also starts from the data's mean path (`data_gait`).
+
+``verify`` runs the swimmer simulator, so only a swimmer's version can be verified; any
+other body is refused in one line before anything is stored.
 """
 
 from __future__ import annotations
@@ -43,9 +48,10 @@ import sqlalchemy as sa
 from scipy.optimize import minimize
 
 from suds_exp.errors import ConfigError
+from suds_exp.gait.joints import describe, is_swimmer, version_joints
 from suds_exp.gait.motion import CycleMotion
 from suds_exp.gait.predict import decimate, derive_seed, fit_map
-from suds_exp.gait.shape import FourierGait, check_bound, within_bound
+from suds_exp.gait.shape import SWIMMER_JOINTS, FourierGait, check_bound, within_bound
 from suds_exp.gait.support import Support
 from suds_exp.gait.trials import simulate_gait_file
 from suds_exp.gait.truth import simulate_gaits
@@ -73,11 +79,12 @@ PENALTY_MM_PER_RAD = 500.0
 class DesignOptions:
     """The recipe of a design run (stored as its definition).
 
-    bound (rad), frequency_hz (Hz), order (Fourier harmonics), trust0 (rad, first trust
-    radius), trust_max (rad), grow / grow_fast / shrink (radius factors), accept_error (relative
-    prediction error that counts as trusted), max_evals (map evaluations per start),
-    cycles (of a verify trial), amplitude_starts (how many of `AMPLITUDES_OF_BOUND` to
-    start from), radius_rule ("error": grow or shrink on the verified prediction's
+    bound (rad, every joint), frequency_hz (Hz), order (Fourier harmonics a joint), trust0
+    (rad, first trust radius), trust_max (rad), grow / grow_fast / shrink (radius factors),
+    accept_error (relative prediction error that counts as trusted), max_evals (map
+    evaluations per start), cycles (of a verify trial), amplitude_starts (how many of
+    `AMPLITUDES_OF_BOUND` to start from), radius_rule ("error": grow or shrink on the
+    verified prediction's
     relative error; "ratio": the textbook rule on achieved / predicted gain).
     """
 
@@ -146,31 +153,43 @@ class Iteration:
 
 @dataclass
 class Design:
-    """A design run: its id in the store, options and iterations."""
+    """A design run: its id in the store, options, the version's actuated joints and
+    the iterations."""
 
     id: int
     prep_version: int
     options: DesignOptions
     iterations: list[Iteration] = field(default_factory=list)
+    joints: tuple[str, ...] = SWIMMER_JOINTS
 
     def to_dict(self) -> dict:
         return {
             "design_id": self.id,
             "prep_version": self.prep_version,
+            "joints": list(self.joints),
             "options": asdict(self.options),
             "iterations": [it.to_dict() for it in self.iterations],
         }
 
 
-def circle(radius: float, order: int, name: str = "circle", lag: float = 0.0) -> FourierGait:
-    """phi1 = r cos t, phi2 = r sin(t + lag) (the paper's O at r = 1, lag = 0) with
-    ``order`` harmonics; a lag (rad) tilts the circle into an ellipse."""
-    a = np.zeros((order, 2))
-    b = np.zeros((order, 2))
-    a[0, 0] = radius
-    a[0, 1] = radius * np.sin(lag)
-    b[0, 1] = radius * np.cos(lag)
-    return FourierGait([0.0, 0.0], a, b, name)
+def circle(
+    radius: float,
+    order: int,
+    name: str = "circle",
+    lag: float = 0.0,
+    joints: tuple[str, ...] = SWIMMER_JOINTS,
+) -> FourierGait:
+    """Joint j at r cos(t - j (pi/2 - lag)) rad, with ``order`` harmonics: for the
+    swimmer phi1 = r cos t, phi2 = r sin(t + lag) (the paper's O at r = 1, lag = 0; a lag
+    tilts the circle into an ellipse); on m joints the travelling wave it generalises
+    (one joint: r cos t)."""
+    m = len(joints)
+    a = np.zeros((order, m))
+    b = np.zeros((order, m))
+    behind = np.arange(m) * (np.pi / 2 - lag)
+    a[0] = radius * np.cos(behind)
+    b[0] = radius * np.sin(behind)
+    return FourierGait(np.zeros(m), a, b, name, joints)
 
 
 def optimise_gait(
@@ -186,8 +205,10 @@ def optimise_gait(
     the trust radius ``trust`` (rad) from ``support``; Nelder-Mead from each start.
     Returns (best gait, its objective)."""
 
+    joints = starts[0].joints
+
     def penalised(x):
-        g = within_bound(FourierGait.from_vector(x, name), bound)
+        g = within_bound(FourierGait.from_vector(x, name, joints), bound)
         excess = support.gait_distance(g) - trust
         if excess > 0:
             # outside: only the way back counts, so the search cannot trade for it
@@ -206,18 +227,33 @@ def optimise_gait(
         for x, f in ((res.x, res.fun), (x0, penalised(x0))):
             if f < best_f:
                 best_x, best_f = x, f
-    best = within_bound(FourierGait.from_vector(best_x, name), bound)
+    best = within_bound(FourierGait.from_vector(best_x, name, joints), bound)
     # the search kept the bound on 256 phases; make it hold on a finer grid too
     while best.max_abs() > bound:
-        best = FourierGait(best.a0, best.a * 0.999, best.b * 0.999, name)
+        best = FourierGait(best.a0, best.a * 0.999, best.b * 0.999, name, joints)
     return best, objective(best)
 
 
-def _circle_starts(opts: DesignOptions) -> list[FourierGait]:
-    """The multi-start circles: radius 1 rad (the paper's O) and `AMPLITUDES_OF_BOUND`
-    of the bound (when below ``amplitude_starts``'s cap), each at every lag of `LAGS_RAD`."""
+def _circle_starts(opts: DesignOptions, joints: tuple[str, ...]) -> list[FourierGait]:
+    """The multi-start circles of ``joints``: radius 1 rad (the paper's O) and
+    `AMPLITUDES_OF_BOUND` of the bound (when below ``amplitude_starts``'s cap), each at
+    every lag of `LAGS_RAD` (one joint: no lag to tilt)."""
     radii = (1.0, *(f * opts.bound for f in AMPLITUDES_OF_BOUND[: opts.amplitude_starts]))
-    return [circle(r, opts.order, lag=d) for r in radii for d in LAGS_RAD]
+    lags = LAGS_RAD if len(joints) > 1 else (0.0,)
+    return [circle(r, opts.order, lag=d, joints=joints) for r in radii for d in lags]
+
+
+def data_gait(samples: pd.DataFrame, order: int, joints: tuple[str, ...]) -> FourierGait:
+    """The training data's mean path: each joint's angle (rad) fitted by least squares on
+    the samples' phase (rad) with ``order`` harmonics, as a gait of ``joints``."""
+    theta = samples["phase"].to_numpy(float)
+    n = np.arange(1, order + 1)
+    basis = np.hstack(
+        [np.ones((len(theta), 1)), np.cos(theta[:, None] * n), np.sin(theta[:, None] * n)]
+    )
+    ra = samples[[f"ra_{j + 1}" for j in range(len(joints))]].to_numpy(float)
+    coef = np.linalg.lstsq(basis, ra, rcond=None)[0]  # (1 + 2 order, m)
+    return FourierGait(coef[0], coef[1 : 1 + order], coef[1 + order :], "data", joints)
 
 
 def _fit_inside(gait: FourierGait, support: Support, bound: float, trust: float) -> FourierGait:
@@ -225,7 +261,7 @@ def _fit_inside(gait: FourierGait, support: Support, bound: float, trust: float)
     for scale in np.linspace(1.0, 0.3, 15):
         x = gait.to_vector().copy()
         x[2:] *= scale
-        g = FourierGait.from_vector(x, gait.name)
+        g = FourierGait.from_vector(x, gait.name, gait.joints)
         if g.max_abs(128) <= bound and support.gait_distance(g) <= trust:
             return g
     return gait
@@ -235,7 +271,7 @@ def design_gait(
     store: Store,
     prep=None,
     options: DesignOptions | None = None,
-    out: str | Path = "gait-design",
+    out: str | Path = Path("reports") / "gait-design",
     config: SimConfig | None = None,
     progress=None,
 ) -> Design:
@@ -249,23 +285,40 @@ def design_gait(
     opts.check()
     make_model(opts.learner)  # an unknown learner is refused before anything is stored
     version = get_version(store, prep)
+    joints = version_joints(version.params)
+    if opts.verify and not is_swimmer(version.params):
+        raise ConfigError(
+            f"verify: {describe(version.name, version.params)}: verify runs each designed "
+            "gait on the swimmer simulator, which moves only the swimmer; design without "
+            "verify",
+            param="verify",
+        )
     samples = version.samples()
     if samples.empty:
         raise ConfigError(
             f"version {version.name} has no samples; preprocess trials first", step="preprocess"
         )
     design_id = _register(store, version.id, opts)
-    design = Design(design_id, version.id, opts)
+    design = Design(design_id, version.id, opts, joints=joints)
     out = Path(out)
     trust = opts.trust0
-    best = circle(1.0, opts.order, "O")
+    best = circle(1.0, opts.order, "O", joints=joints)
     best_achieved = -np.inf
     for it in range(1, opts.iterations + 1):
         started = time.perf_counter()
         fitted = fit_map(samples, opts.learner)
         support = Support.of(decimate(samples))
         name = f"design-{design_id}-it{it}.toml"
-        starts = [_fit_inside(g, support, opts.bound, trust) for g in (best, *_circle_starts(opts))]
+        starts = [
+            _fit_inside(g, support, opts.bound, trust)
+            for g in (best, *_circle_starts(opts, joints))
+        ]
+        if all(support.gait_distance(g) > trust for g in starts):
+            # no circle fits the trust region (on a body of many joints whose data are not
+            # circles): start too from the data's own mean path, inside it by construction
+            starts.append(
+                _fit_inside(data_gait(samples, opts.order, joints), support, opts.bound, trust)
+            )
         gait, _ = optimise_gait(
             lambda g, fitted=fitted: fitted.forward(g, opts.frequency_hz),
             support,
@@ -277,8 +330,10 @@ def design_gait(
         )
         check_bound(gait, opts.bound, name)
         predicted = fitted.motion(gait, opts.frequency_hz)
+        flag = support.flag(gait)
         distance = support.gait_distance(gait)
-        summary = support.summary() | {"n_trials": int(samples["trial_id"].nunique())}
+        summary = support.summary(joints) | {"n_trials": int(samples["trial_id"].nunique())}
+        summary |= flag
         achieved, trial_id = None, None
         used = trust
         if opts.verify:

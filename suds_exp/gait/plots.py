@@ -23,6 +23,16 @@ def _pyplot():
     return plt
 
 
+def _save(plt, fig, path: str | Path) -> Path:
+    """Lay out, write ``fig`` as a PNG at ``path`` (its folder made), close it."""
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
 def _panel(ax, phi1, phi2, A, curl, inside, gaits, title, unit, labels=None):
     p1, p2 = np.meshgrid(phi1, phi2, indexing="ij")
     lim = np.nanmax(np.abs(curl)) if np.isfinite(curl).any() else 1.0
@@ -78,23 +88,36 @@ def draw_connection(
             fig.colorbar(mesh, ax=axes[r, c], shrink=0.8)
     if gaits:
         axes[0, 0].legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
-def draw_design(design, learned: LearnedConnection, path: str | Path) -> Path:
+def draw_design(design, learned: LearnedConnection | None, path: str | Path) -> Path:
     """One PNG of a design run: its gaits on the learned height function of vx, forward
     displacement per cycle by iteration (predicted, achieved), predicted against
-    achieved. ``design``: a `suds_exp.gait.design.Design`."""
+    achieved. ``design``: a `suds_exp.gait.design.Design`. ``learned`` None (a body
+    without two actuated joints has no height function to draw): the first panel says so."""
     plt = _pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.4))
+    if learned is None:
+        axes[0].axis("off")
+        axes[0].text(
+            0.5,
+            0.5,
+            f"no height function:\n{len(design.joints)} actuated joint(s), not 2",
+            ha="center",
+            va="center",
+        )
+    else:
+        _height_panel(fig, axes[0], design, learned)
+    _displacement_panels(axes[1], axes[2], design)
+    return _save(plt, fig, path)
+
+
+def _height_panel(fig, ax, design, learned: LearnedConnection) -> None:
+    """The design's gaits on the learned height function of vx."""
     gaits = [it.gait for it in design.iterations]
     mesh, _ = _panel(
-        axes[0],
+        ax,
         learned.phi1,
         learned.phi2,
         learned.A[:, :, 0, :],
@@ -105,28 +128,27 @@ def draw_design(design, learned: LearnedConnection, path: str | Path) -> Path:
         "mm/rad^2",
         [f"it{it.iteration}" for it in design.iterations],
     )
-    fig.colorbar(mesh, ax=axes[0], shrink=0.8)
-    axes[0].legend(fontsize=7, loc="lower left")
+    fig.colorbar(mesh, ax=ax, shrink=0.8)
+    ax.legend(fontsize=7, loc="lower left")
+
+
+def _displacement_panels(by_iteration, against, design) -> None:
+    """Forward displacement per iteration (predicted, achieved) and predicted against
+    achieved, on the two axes given."""
     its = [it.iteration for it in design.iterations]
     pred = [it.predicted.forward_mm for it in design.iterations]
-    axes[1].plot(its, pred, "o-", label="predicted")
+    by_iteration.plot(its, pred, "o-", label="predicted")
     ach = [it.achieved.forward_mm if it.achieved else np.nan for it in design.iterations]
     if np.isfinite(ach).any():
-        axes[1].plot(its, ach, "s-", label="achieved (simulator)")
-        axes[2].plot(pred, ach, "o")
+        by_iteration.plot(its, ach, "s-", label="achieved (simulator)")
+        against.plot(pred, ach, "o")
         lo, hi = np.nanmin(pred + ach), np.nanmax(pred + ach)
-        axes[2].plot([lo, hi], [lo, hi], "k--", lw=0.8)
+        against.plot([lo, hi], [lo, hi], "k--", lw=0.8)
         for i, p, a in zip(its, pred, ach, strict=True):
-            axes[2].annotate(str(i), (p, a), fontsize=8)
-    axes[1].set_xlabel("iteration")
-    axes[1].set_ylabel("forward displacement per cycle (mm)")
-    axes[1].legend()
-    axes[2].set_xlabel("predicted (mm/cycle)")
-    axes[2].set_ylabel("achieved (mm/cycle)")
-    axes[2].set_title("predicted against achieved", fontsize=9)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+            against.annotate(str(i), (p, a), fontsize=8)
+    by_iteration.set_xlabel("iteration")
+    by_iteration.set_ylabel("forward displacement per cycle (mm)")
+    by_iteration.legend()
+    against.set_xlabel("predicted (mm/cycle)")
+    against.set_ylabel("achieved (mm/cycle)")
+    against.set_title("predicted against achieved", fontsize=9)

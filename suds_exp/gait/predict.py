@@ -13,13 +13,20 @@ the gait and the body's path reconstructed by the path-ordered SE(2) integral
 The gait is rolled for `N_CYCLES` cycles and cycles `MEASURED` are averaged (the rollout
 of r_p settles first); a learner without memory (no r_p, no branching) needs one cycle.
 A bootstrap over training trials (resampled with replacement,
-seeds derived from the request) gives each number's interval.
+seeds derived from the request) gives each number's interval: the 2.5 and 97.5
+percentiles of at least `MIN_BOOT` refits (`percentile_interval`); an estimate outside
+its interval is reported with a note saying why. Every prediction says whether the gait
+lies inside the training data's support (`suds_exp.gait.support`): outside, the map
+extrapolates.
+
+A gait is matched to the version's actuated joints by name (`suds_exp.gait.joints`).
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -27,8 +34,10 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.errors import ConfigError
+from suds_exp.gait.joints import body_label, match_joints, version_joints
 from suds_exp.gait.motion import CycleMotion, cycle_motion, integrate_twists
 from suds_exp.gait.shape import TWO_PI, Gait
+from suds_exp.gait.support import Support, actuated_columns
 from suds_exp.models import make_model
 from suds_exp.models.base import Columns, TimeSeries
 from suds_exp.models.registry import GMR
@@ -41,6 +50,8 @@ MEASURED = (2, 3)
 #: Samples per cycle of the rolled gait (and of training data whose rate is unknown).
 SAMPLES_PER_CYCLE = 100
 MOTION_KEYS = ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s")
+#: Decimals each motion number is reported with (`CycleMotion.to_dict`'s), its interval too.
+DIGITS = {"forward_mm": 4, "lateral_mm": 4, "turn_rad": 6, "mean_vx_mm_s": 4}
 
 
 def derive_seed(*key) -> int:
@@ -81,8 +92,8 @@ def gait_samples(
     samples_per_cycle: int = SAMPLES_PER_CYCLE,
 ) -> pd.DataFrame:
     """A samples frame of the gait run at frequency_hz (Hz) from phase 0: the standard
-    columns (t s, phase rad, ra rad, dra rad/s), r_p (k columns) held at rp0 (mm) for
-    a rollout's start, dr_p/dt and v_b as NaN."""
+    columns (t s, phase rad, ra_1 .. ra_m rad, dra_1 .. dra_m rad/s; m the gait's joints),
+    r_p (k columns) held at rp0 (mm) for a rollout's start, dr_p/dt and v_b as NaN."""
     return GaitTable.of(frequency_hz, k, rp0, n_cycles, samples_per_cycle).columns(gait).frame()
 
 
@@ -135,7 +146,9 @@ class GaitTable:
         """The samples table of ``gait`` (the columns of `gait_samples`)."""
         ra = gait.shape(self.theta)
         dra = gait.rate(self.theta) * TWO_PI * self.frequency_hz
-        actuated = {"ra_1": ra[:, 0], "ra_2": ra[:, 1], "dra_1": dra[:, 0], "dra_2": dra[:, 1]}
+        m = ra.shape[1]
+        actuated = {f"ra_{j + 1}": ra[:, j] for j in range(m)}
+        actuated |= {f"dra_{j + 1}": dra[:, j] for j in range(m)}
         return Columns(self.head | actuated | self.tail, self.series)
 
 
@@ -237,8 +250,10 @@ def fit_map(
 
 @dataclass
 class GaitPrediction:
-    """Predicted motion of one gait (point fit on all training trials) and bootstrap
-    intervals (2.5 and 97.5 percentiles over ``n_boot`` refits on resampled trials)."""
+    """Predicted motion of one gait (point fit on all training trials), bootstrap
+    intervals (2.5 and 97.5 percentiles over ``n_boot`` refits on resampled trials,
+    `percentile_interval`) with a note for each estimate outside its interval, and the
+    gait's place in the training data's support (`Support.flag`)."""
 
     gait: Gait
     frequency_hz: float
@@ -246,13 +261,68 @@ class GaitPrediction:
     motion: CycleMotion
     interval: dict = field(default_factory=dict)
     n_boot: int = 0
+    support: dict = field(default_factory=dict)
+    notes: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        out = {"gait": self.gait.name, "frequency_hz": self.frequency_hz, "learner": self.learner}
+        out = {"gait": self.gait.name, "joints": list(self.gait.joints)}
+        out |= {"frequency_hz": self.frequency_hz, "learner": self.learner}
         out |= self.motion.to_dict()
         out["n_boot"] = self.n_boot
         out["interval"] = self.interval
+        out["interval_notes"] = self.notes
+        out["support"] = self.support
         return out
+
+
+#: Fewest refits a 95 % percentile interval is given from: the 2.5 and 97.5 percentiles
+#: of B refits need at least one refit beyond each (B x 2.5 % >= 1). With 3 refits the
+#: "interval" is the range of 3 numbers, and the full fit fell outside it (issue 39).
+MIN_BOOT = 40
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A percentile bootstrap interval: ``low``, ``high`` (the estimate's unit) and
+    ``note``, empty unless the estimate lies outside the interval (then why)."""
+
+    low: float
+    high: float
+    note: str = ""
+
+
+def percentile_interval(estimate: float, boots: np.ndarray, level: float = 0.95) -> Interval:
+    """The percentile interval of ``boots`` (B,) refits at ``level`` around ``estimate``
+    (the fit on all trials), with B >= `MIN_BOOT` at 95 % and one refit beyond each tail
+    at any level (ConfigError otherwise).
+
+    The interval is the refits' spread, not centred on the estimate by construction: when
+    resampling trials shifts the refits (bootstrap bias: a resample holds about 63 % of
+    the distinct trials, so its map is smoother or rougher than the full fit's), the
+    estimate can lie outside. The interval is then reported as it is, with a note giving
+    the bias (mean of refits - estimate) rather than moved or widened to include it.
+    """
+    boots = np.asarray(boots, float)
+    tail = 50 * (1 - level)
+    needed = max(MIN_BOOT, math.ceil(100 / tail - 1e-9))  # one refit beyond each tail
+    if len(boots) < needed:
+        raise ConfigError(
+            f"n_boot {len(boots)}: a {100 * level:g} % percentile interval needs at least "
+            f"{needed} refits (one beyond each {tail:g} % tail); give 0 for no interval or "
+            f"{needed} or more",
+            param="n_boot",
+        )
+    low, high = (float(v) for v in np.percentile(boots, [tail, 100 - tail]))
+    if low <= estimate <= high:
+        return Interval(low, high)
+    bias = float(np.mean(boots)) - estimate
+    side = "below" if estimate < low else "above"
+    note = (
+        f"estimate {estimate:.4g} outside its interval [{low:.4g}, {high:.4g}] ({side}): the "
+        f"refits on resampled trials are shifted from the fit on all trials (bootstrap bias "
+        f"{bias:+.4g}); the interval shows their spread, the estimate is the full fit"
+    )
+    return Interval(low, high, note)
 
 
 def bootstrap_draws(samples: pd.DataFrame, n_boot: int, seed: int):
@@ -276,12 +346,25 @@ def predict_gaits(
     params: dict | None = None,
     n_boot: int = 0,
     seed: int = 0,
+    joints: Sequence[str] | None = None,
 ) -> list[GaitPrediction]:
     """Predict each gait's net motion per cycle at frequency_hz (Hz) from a learner fitted
-    on ``samples``; with n_boot > 0, also a bootstrap interval over training trials."""
+    on ``samples``; with n_boot > 0 (at least `MIN_BOOT`), also a bootstrap interval over
+    training trials. Each prediction carries the gait's support flag.
+
+    joints: the names of the samples' r_a columns ra_1 .. ra_m (a version's,
+    `suds_exp.gait.joints.version_joints`); each gait is matched to them by name. None:
+    the gaits' columns must be as many as the samples' and are taken in order.
+    """
     if not frequency_hz > 0:
         raise ConfigError(f"frequency {frequency_hz!r}: must be > 0 Hz", param="freq")
+    if n_boot < 0:
+        raise ConfigError(f"n_boot {n_boot}: must be >= 0", param="n_boot")
+    if 0 < n_boot < MIN_BOOT:
+        percentile_interval(0.0, np.zeros(n_boot))  # refused before any fit
+    gaits = _matched(samples, gaits, joints)
     fitted = fit_map(samples, learner, params)
+    support = Support.of(decimate(samples))
     points = [fitted.motion(g, frequency_hz) for g in gaits]
     boots = np.empty((n_boot, len(gaits), len(MOTION_KEYS)))
     for b, frame in enumerate(bootstrap_draws(samples, n_boot, seed)):
@@ -291,15 +374,38 @@ def predict_gaits(
             boots[b, j] = [getattr(m, key) for key in MOTION_KEYS]
     out = []
     for j, (g, m) in enumerate(zip(gaits, points, strict=True)):
-        interval = {}
-        if n_boot:
-            lo, hi = np.percentile(boots[:, j], [2.5, 97.5], axis=0)
-            interval = {
-                key: [round(float(lo[i]), 4), round(float(hi[i]), 4)]
-                for i, key in enumerate(MOTION_KEYS)
-            }
-        out.append(GaitPrediction(g, frequency_hz, learner, m, interval, n_boot))
+        interval, notes = {}, {}
+        for i, key in enumerate(MOTION_KEYS if n_boot else ()):
+            iv = percentile_interval(getattr(m, key), boots[:, j, i])
+            interval[key] = _outward(iv, DIGITS[key])
+            if iv.note:
+                notes[key] = iv.note
+        flag = support.flag(g)
+        out.append(GaitPrediction(g, frequency_hz, learner, m, interval, n_boot, flag, notes))
     return out
+
+
+def _outward(iv: Interval, digits: int) -> list[float]:
+    """[low, high] rounded outwards to ``digits`` decimals: rounding to nearest could put
+    an estimate (rounded to the same digits) just outside its reported interval."""
+    scale = 10.0**digits
+    return [math.floor(iv.low * scale) / scale, math.ceil(iv.high * scale) / scale]
+
+
+def _matched(samples: pd.DataFrame, gaits: Sequence[Gait], joints) -> list[Gait]:
+    """The gaits with their columns in the order of the samples' r_a (see
+    `predict_gaits`); refused in one line when they do not fit."""
+    m = len(actuated_columns(samples)[0])
+    if joints is not None:
+        return [match_joints(g, joints, f"gait {g.name}") for g in gaits]
+    for g in gaits:
+        if len(g.joints) != m:
+            raise ConfigError(
+                f"gait {g.name}: {len(g.joints)} joint(s) ({', '.join(g.joints)}); the "
+                f"samples hold {m} actuated joint(s) (ra_1 .. ra_{m})",
+                param="gait_file",
+            )
+    return list(gaits)
 
 
 def predict_gait(
@@ -315,8 +421,13 @@ def predict_gait(
     """`gait predict`: fit ``learner`` on version ``prep``'s trials (all by default) and
     predict ``gait`` at frequency_hz; the bootstrap's seeds derive from the request."""
     version = get_version(store, prep)
+    joints = version_joints(version.params)
+    where = f"{gait.name}: version {version.name} ({body_label(version.params)})"
+    gait = match_joints(gait, joints, where)
+    if 0 < n_boot < MIN_BOOT:
+        percentile_interval(0.0, np.zeros(n_boot))  # refused before the samples are read
     samples = version.samples(trials)
     if samples.empty:
         raise ConfigError(f"trials {trials}: no samples in version {version.name}", param="trials")
     seed = derive_seed("gait-predict", version.id, learner, gait.name, frequency_hz, trials)
-    return predict_gaits(samples, [gait], frequency_hz, learner, params, n_boot, seed)[0]
+    return predict_gaits(samples, [gait], frequency_hz, learner, params, n_boot, seed, joints)[0]

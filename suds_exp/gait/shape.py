@@ -1,20 +1,25 @@
-"""A gait: a closed path of the actuated joints r_a = (phi1, phi2) over one cycle.
+"""A gait: a closed path of the actuated joints r_a over one cycle, one column per
+actuated joint, named as the body's joints (``joints``; the swimmer's are phi1, phi2).
 
 Two kinds, one face (`Gait.shape(theta)`, `Gait.rate(theta)`, theta = phase in rad):
 
-- `FourierGait`: phi_j(theta) = a0_j + sum_n (a_nj cos(n theta) + b_nj sin(n theta)),
-  read from TOML (``[phi1] a0 = 0.0, cos = [1.2], sin = [0.0]``, the same for phi2) and
+- `FourierGait`: r_j(theta) = a0_j + sum_n (a_nj cos(n theta) + b_nj sin(n theta)),
+  read from TOML (one table a joint: ``[phi1] a0 = 0.0, cos = [1.2], sin = [0.0]``) and
   what the designer optimises.
-- `SampledGait`: rows ``phase_rad,phi1_rad,phi2_rad`` over one cycle (CSV), phase in
-  [0, 2 pi) in increasing order, interpolated by a periodic cubic spline.
+- `SampledGait`: rows ``phase_rad,<joint>_rad,...`` over one cycle (CSV; the swimmer's
+  ``phase_rad,phi1_rad,phi2_rad``), phase in [0, 2 pi) in increasing order, interpolated
+  by a periodic cubic spline.
 
 A file is refused in one line (`ConfigError` naming the file and row) when the phase has
 a gap, the ends do not meet (the path is not closed), or an angle exceeds the bound.
+Which body a gait fits is decided by its joints' names (`suds_exp.gait.joints`).
 """
 
 from __future__ import annotations
 
+import json
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,59 +40,74 @@ GAP_FACTOR = 3.0
 #: Ends meet when the step from the last row to the first (across 2 pi), per rad of
 #: phase, is at most this many times the steepest step between rows.
 END_FACTOR = 3.0
-CSV_COLUMNS = ("phase_rad", "phi1_rad", "phi2_rad")
+#: The swimmer's actuated joints: a gait's columns when none are named.
+SWIMMER_JOINTS = ("phi1", "phi2")
+#: A CSV column of a joint: its name and this suffix (``phi1_rad``).
+ANGLE_SUFFIX = "_rad"
+
+
+def default_joints(m: int) -> tuple[str, ...]:
+    """Names of m joints when none are given: phi1 .. phim (the swimmer's at m = 2)."""
+    return tuple(f"phi{j + 1}" for j in range(m))
 
 
 class Gait:
-    """A periodic joint path. Subclasses give `shape` and `rate`; `name` labels it."""
+    """A periodic joint path. Subclasses give `shape` and `rate`; `name` labels it and
+    ``joints`` (m names) say which joint each column moves."""
 
     name: str
+    joints: tuple[str, ...] = SWIMMER_JOINTS
 
     def shape(self, theta) -> np.ndarray:
-        """r_a at phases theta (rad, any shape): array (*theta.shape, 2), rad."""
+        """r_a at phases theta (rad, any shape): array (*theta.shape, m), rad."""
         raise NotImplementedError
 
     def rate(self, theta) -> np.ndarray:
-        """d r_a / d theta at phases theta: array (*theta.shape, 2), rad per rad."""
+        """d r_a / d theta at phases theta: array (*theta.shape, m), rad per rad."""
         raise NotImplementedError
 
     def cycle(self, n: int = 200) -> tuple[np.ndarray, np.ndarray]:
-        """(phase (n,) rad in [0, 2 pi), r_a (n, 2) rad) over one cycle."""
+        """(phase (n,) rad in [0, 2 pi), r_a (n, m) rad) over one cycle."""
         theta = TWO_PI * np.arange(n) / n
         return theta, self.shape(theta)
 
     def max_abs(self, n: int = 720) -> float:
-        """Largest |phi1|, |phi2| over the cycle (rad)."""
+        """Largest |angle| of any joint over the cycle (rad)."""
         return float(np.abs(self.cycle(n)[1]).max())
 
     def to_dict(self, n: int = 100) -> dict:
-        """JSON-ready: name and the path sampled at n phases (``phase_rad``,
-        ``phi1_rad``, ``phi2_rad`` lists)."""
+        """JSON-ready: name, joints and the path sampled at n phases (``phase_rad`` and
+        one ``<joint>_rad`` list a joint, e.g. ``phi1_rad``, ``phi2_rad``)."""
         theta, r = self.cycle(n)
-        return {
-            "name": self.name,
-            "phase_rad": [round(float(x), 6) for x in theta],
-            "phi1_rad": [round(float(x), 6) for x in r[:, 0]],
-            "phi2_rad": [round(float(x), 6) for x in r[:, 1]],
-        }
+        out = {"name": self.name, "joints": list(self.joints)}
+        out["phase_rad"] = [round(float(x), 6) for x in theta]
+        for j, joint in enumerate(self.joints):
+            out[joint + ANGLE_SUFFIX] = [round(float(x), 6) for x in r[:, j]]
+        return out
 
 
 @dataclass
 class FourierGait(Gait):
-    """phi_j = a0[j] + sum_n a[n-1, j] cos(n theta) + b[n-1, j] sin(n theta), rad.
+    """r_j = a0[j] + sum_n a[n-1, j] cos(n theta) + b[n-1, j] sin(n theta), rad.
 
-    a0 (2,), a (N, 2), b (N, 2): N harmonics of both joints.
+    a0 (m,), a (N, m), b (N, m): N harmonics of each of the m joints; ``joints`` their
+    names (default phi1 .. phim).
     """
 
     a0: np.ndarray
     a: np.ndarray
     b: np.ndarray
     name: str = "fourier"
+    joints: tuple[str, ...] | None = None
 
     def __post_init__(self):
-        self.a0 = np.asarray(self.a0, float).reshape(2)
-        self.a = np.asarray(self.a, float).reshape(-1, 2)
-        self.b = np.asarray(self.b, float).reshape(-1, 2)
+        self.a0 = np.atleast_1d(np.asarray(self.a0, float))
+        m = len(self.a0)
+        self.a = np.asarray(self.a, float).reshape(-1, m)
+        self.b = np.asarray(self.b, float).reshape(-1, m)
+        self.joints = default_joints(m) if self.joints is None else tuple(self.joints)
+        if len(self.joints) != m:
+            raise ConfigError(f"Fourier gait: {m} joint(s) of coefficients, joints {self.joints}")
         if self.a.shape != self.b.shape:
             raise ConfigError("Fourier gait: cos and sin need the same number of harmonics")
 
@@ -110,22 +130,27 @@ class FourierGait(Gait):
         return (-s * n) @ self.a + (c * n) @ self.b
 
     def to_vector(self) -> np.ndarray:
-        """(a0, a, b) flattened: 2 + 4 N numbers (the designer's variables)."""
+        """(a0, a, b) flattened: m + 2 m N numbers (the designer's variables)."""
         return np.concatenate([self.a0, self.a.ravel(), self.b.ravel()])
 
     @classmethod
-    def from_vector(cls, x, name: str = "fourier") -> FourierGait:
+    def from_vector(
+        cls, x, name: str = "fourier", joints: tuple[str, ...] = SWIMMER_JOINTS
+    ) -> FourierGait:
+        """The gait of `to_vector`'s numbers ``x`` for ``joints`` (m names)."""
         x = np.asarray(x, float)
-        n = (len(x) - 2) // 4
-        return cls(x[:2], x[2 : 2 + 2 * n].reshape(n, 2), x[2 + 2 * n :].reshape(n, 2), name)
+        m = len(joints)
+        n = (len(x) - m) // (2 * m)
+        a, b = x[m : m + m * n].reshape(n, m), x[m + m * n :].reshape(n, m)
+        return cls(x[:m], a, b, name, tuple(joints))
 
     def to_toml(self) -> str:
         """The TOML text `read_gait_file` reads back."""
         lines = [f'name = "{self.name}"']
-        for j in range(2):
+        for j, joint in enumerate(self.joints):
             lines += [
                 "",
-                f"[phi{j + 1}]",
+                f"[{_toml_key(joint)}]",
                 f"a0 = {self.a0[j]:.9g}",
                 "cos = [" + ", ".join(f"{v:.9g}" for v in self.a[:, j]) + "]",
                 "sin = [" + ", ".join(f"{v:.9g}" for v in self.b[:, j]) + "]",
@@ -133,17 +158,26 @@ class FourierGait(Gait):
         return "\n".join(lines) + "\n"
 
 
+def _toml_key(name: str) -> str:
+    """A joint's name as a TOML table key: bare when TOML allows, else quoted."""
+    return name if re.fullmatch(r"[A-Za-z0-9_-]+", name) else json.dumps(name)
+
+
 @dataclass
 class SampledGait(Gait):
-    """A path given at phases ``phase`` (n,) rad in [0, 2 pi) with r_a ``phi`` (n, 2)
-    rad, interpolated by a periodic cubic spline."""
+    """A path given at phases ``phase`` (n,) rad in [0, 2 pi) with r_a ``phi`` (n, m)
+    rad, interpolated by a periodic cubic spline; ``joints`` the m joints' names."""
 
     phase: np.ndarray
     phi: np.ndarray
     name: str = "sampled"
+    joints: tuple[str, ...] | None = None
     _spline: CubicSpline = field(init=False, repr=False)
 
     def __post_init__(self):
+        self.phi = np.asarray(self.phi, float).reshape(len(self.phase), -1)
+        m = self.phi.shape[1]
+        self.joints = default_joints(m) if self.joints is None else tuple(self.joints)
         x = np.append(self.phase, self.phase[0] + TWO_PI)
         y = np.vstack([self.phi, self.phi[:1]])
         self._spline = CubicSpline(x, y, axis=0, bc_type="periodic")
@@ -188,7 +222,7 @@ def ellipse(a1: float, a2: float, shift: float = 0.0, c1=0.0, c2=0.0, name=None)
 
 def within_bound(gait: FourierGait, bound: float, n: int = 256) -> FourierGait:
     """The gait with its oscillation (not its centre) scaled down just enough that
-    |phi1|, |phi2| <= bound (rad) on n phases; unchanged when already inside. A search
+    every joint's |angle| <= bound (rad) on n phases; unchanged when already inside. A search
     over coefficients through this map never leaves the bound, and the bound's edge is
     continuous for it (no penalty wall)."""
     theta = TWO_PI * np.arange(n) / n
@@ -201,11 +235,11 @@ def within_bound(gait: FourierGait, bound: float, n: int = 256) -> FourierGait:
     with np.errstate(divide="ignore", invalid="ignore"):
         room = np.where(osc > 0, (bound - a0) / osc, np.where(osc < 0, (-bound - a0) / osc, np.inf))
     scale = min(1.0, float(np.min(room)) * (1 - 1e-9))
-    return FourierGait(a0, gait.a * scale, gait.b * scale, gait.name)
+    return FourierGait(a0, gait.a * scale, gait.b * scale, gait.name, gait.joints)
 
 
 def check_bound(gait: Gait, bound: float, where: str) -> None:
-    """Refuse a gait that leaves |phi1|, |phi2| <= bound (rad)."""
+    """Refuse a gait that leaves |angle| <= bound (rad) at any joint."""
     worst = gait.max_abs()
     if worst > bound + 1e-9:
         raise ConfigError(
@@ -215,9 +249,11 @@ def check_bound(gait: Gait, bound: float, where: str) -> None:
 
 
 def read_gait_file(path: str | Path, bound: float = JOINT_LIMIT_RAD) -> Gait:
-    """A gait from a CSV (``phase_rad,phi1_rad,phi2_rad``) or TOML (Fourier) file.
+    """A gait from a CSV (``phase_rad,<joint>_rad,...``, the swimmer's
+    ``phase_rad,phi1_rad,phi2_rad``) or TOML (Fourier, one table a joint) file.
 
-    The gait's name is the file's name. Raises ConfigError (one line, naming the file and
+    The gait's name is the file's name, its joints the columns' (tables') names in file
+    order. Raises ConfigError (one line, naming the file and
     row) for a missing file, wrong columns, phase outside [0, 2 pi) or out of order, a gap
     in phase, ends that do not meet, or an angle beyond ``bound`` (rad).
     """
@@ -231,7 +267,7 @@ def read_gait_file(path: str | Path, bound: float = JOINT_LIMIT_RAD) -> Gait:
         gait = _read_toml(path)
     else:
         raise ConfigError(
-            f"{path}: expected a .csv (phase_rad,phi1_rad,phi2_rad) or .toml (Fourier) gait",
+            f"{path}: expected a .csv (phase_rad,<joint>_rad,...) or .toml (Fourier) gait",
             param="gait_file",
         )
     check_bound(gait, bound, str(path))
@@ -244,15 +280,13 @@ def _read_csv(path: Path) -> SampledGait:
     except (ValueError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: not a readable CSV ({exc})", param="gait_file") from None
     cols = [c.strip() for c in table.columns]
-    if cols != list(CSV_COLUMNS):
-        raise ConfigError(
-            f"{path}: columns {','.join(cols)}; expected {','.join(CSV_COLUMNS)}",
-            param="gait_file",
-        )
+    joints = _csv_joints(path, cols)
     values = table.apply(pd.to_numeric, errors="coerce").to_numpy(float)
     bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
     if len(bad):
-        raise ConfigError(f"{path}: row {bad[0] + 2}: expected three numbers", param="gait_file")
+        raise ConfigError(
+            f"{path}: row {bad[0] + 2}: expected {len(cols)} numbers", param="gait_file"
+        )
     if len(values) < 8:
         raise ConfigError(f"{path}: {len(values)} rows; expected at least 8 over one cycle")
     phase, phi = values[:, 0], values[:, 1:]
@@ -288,7 +322,25 @@ def _read_csv(path: Path) -> SampledGait:
             f"{np.round(phi[0], 3).tolist()} rad); a gait is a closed path over one cycle",
             param="gait_file",
         )
-    return SampledGait(phase, phi, path.name)
+    return SampledGait(phase, phi, path.name, joints)
+
+
+def _csv_joints(path: Path, cols: list[str]) -> tuple[str, ...]:
+    """The joints of a gait CSV's header ``phase_rad,<joint>_rad,...`` (one or more)."""
+    expected = "phase_rad,JOINT_rad,... (one column per actuated joint, e.g. phi1_rad,phi2_rad)"
+    if len(cols) < 2 or cols[0] != "phase_rad":
+        raise ConfigError(
+            f"{path}: columns {','.join(cols)}; expected {expected}", param="gait_file"
+        )
+    joints = []
+    for c in cols[1:]:
+        if not c.endswith(ANGLE_SUFFIX) or c == ANGLE_SUFFIX:
+            raise ConfigError(f"{path}: column {c!r}: expected {expected}", param="gait_file")
+        joints.append(c[: -len(ANGLE_SUFFIX)])
+    twice = sorted({j for j in joints if joints.count(j) > 1})
+    if twice:
+        raise ConfigError(f"{path}: joint {twice[0]!r} has two columns", param="gait_file")
+    return tuple(joints)
 
 
 def _read_toml(path: Path) -> FourierGait:
@@ -296,14 +348,17 @@ def _read_toml(path: Path) -> FourierGait:
         doc = tomllib.loads(path.read_text())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: not valid TOML ({exc})", param="gait_file") from None
-    unknown = set(doc) - {"name", "phi1", "phi2"}
-    if unknown or not {"phi1", "phi2"} <= set(doc):
+    joints = [k for k in doc if k != "name"]
+    loose = [k for k in joints if not isinstance(doc[k], dict)]
+    if loose or not joints:
+        what = f"entry {loose[0]!r} is not a table; expected" if loose else "no joint; expected"
         raise ConfigError(
-            f"{path}: expected tables [phi1] and [phi2] (keys a0, cos, sin) and an optional name",
+            f"{path}: {what} one table a joint, named as the body's joints ([phi1], "
+            "[phi2] for the swimmer; keys a0, cos, sin), and an optional name",
             param="gait_file",
         )
     a0, cos, sin = [], [], []
-    for j in ("phi1", "phi2"):
+    for j in joints:
         t = doc[j]
         extra = set(t) - {"a0", "cos", "sin"}
         if extra:
@@ -317,11 +372,12 @@ def _read_toml(path: Path) -> FourierGait:
     n = max(len(c) for c in cos + sin)
     if n == 0:
         raise ConfigError(f"{path}: no harmonics; give cos or sin coefficients", param="gait_file")
-    a = np.zeros((n, 2))
-    b = np.zeros((n, 2))
-    for j in range(2):
+    m = len(joints)
+    a = np.zeros((n, m))
+    b = np.zeros((n, m))
+    for j in range(m):
         a[: len(cos[j]), j] = cos[j]
         b[: len(sin[j]), j] = sin[j]
     if not (np.isfinite(a).all() and np.isfinite(b).all() and np.isfinite(a0).all()):
         raise ConfigError(f"{path}: coefficients must be finite numbers", param="gait_file")
-    return FourierGait(a0, a, b, path.name)
+    return FourierGait(a0, a, b, path.name, tuple(joints))
