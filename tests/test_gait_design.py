@@ -232,3 +232,24 @@ def test_connection_compares_the_learned_map_with_the_simulators(db, tmp_path):
         app, ["gait", "connection", "--out", str(out), "--directions", "all", "--db", str(db)]
     )
     assert r.exit_code == 2 and "--directions" in r.output + (r.stderr or "")
+
+
+def test_run_report_and_findings_work_after_verify(db, tmp_path):
+    # issue 39: the verify trials were conditions outside the design; the next plain run
+    # refused (a one-trial condition has no same-condition pair) and report crashed
+    out = str(tmp_path / "out")
+    ok("gait", "design", "--iterations", "1", "--verify", "--order", "1", "--out", out,
+       "--db", str(db), "--json")  # fmt: skip
+    levels = Store(db).query_df(
+        "SELECT axis, level FROM experiment_levels WHERE added_by IS NOT NULL"
+    )
+    assert levels.values.tolist() == [["gait", "design-1-it1.toml"]]
+    ok("run", "after", "--models", "phase-only,TLS", "--boots", "2", "--train-cycles", "3",
+       "--db", str(db), "-q")  # fmt: skip
+    out = tmp_path / "report"
+    ok("report", "after", "--out", str(out), "--db", str(db))
+    assert "design-1-it1.toml" in (out / "index.html").read_text()
+    paper = Path(__file__).resolve().parents[1] / "suds_exp" / "experiment" / "paper.toml"
+    ok("report", "after", "--out", str(tmp_path / "r2"), "--experiment", str(paper),
+       "--db", str(db))
+    ok("findings", "after", "--boot", "10", "--db", str(db))

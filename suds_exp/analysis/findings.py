@@ -838,10 +838,29 @@ def campaign_passive_information(store, campaign: str, **kwargs) -> pd.DataFrame
         samples = get_version(store, row["prep_version"].iloc[0]).samples() if len(row) else None
     except SudsError:
         samples = None
-    if samples is None or samples.empty or not any(c.startswith("rp_") for c in samples):
+    if samples is None or samples.empty:
         # results without stored samples (imported, synthetic): nothing to measure
-        return pd.DataFrame(columns=PASSIVE_COLUMNS)
-    return passive_information(samples, **kwargs)
+        return _no_passive("the campaign's samples are not stored")
+    if not any(c.startswith("rp_") for c in samples):
+        return _no_passive("the samples have no passive shape (rp_*)")
+    table = passive_information(samples, **kwargs)
+    if table.empty:
+        return _no_passive(
+            f"no condition has two trials at one frequency in the {len(samples):,} stored "
+            "samples (a pair fits on one trial and tests on another)"
+        )
+    return table
+
+
+def _no_passive(reason: str) -> pd.DataFrame:
+    table = pd.DataFrame(columns=PASSIVE_COLUMNS)
+    table.attrs["reason"] = reason
+    return table
+
+
+def passive_reason(table: pd.DataFrame) -> str:
+    """Why an empty passive-information table (`campaign_passive_information`) is empty."""
+    return table.attrs.get("reason", "no pair of trials to measure it on")
 
 
 def passive_display(table: pd.DataFrame) -> pd.DataFrame:

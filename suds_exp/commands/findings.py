@@ -13,6 +13,7 @@ from suds_exp.analysis.findings import (
     findings_headline,
     findings_json,
     passive_display,
+    passive_reason,
 )
 
 
@@ -40,7 +41,7 @@ def print_findings(table: pd.DataFrame, campaign: str) -> None:
 def print_passive_information(table: pd.DataFrame) -> None:
     """Print the passive-information table and its explanation on the terminal."""
     if table.empty:
-        console.out.print("what the passive shape adds: not measurable (no stored samples)")
+        console.out.print(f"what the passive shape adds: not measurable ({passive_reason(table)})")
         return
     console.print_frame(passive_display(table), title="what the passive shape adds")
     console.out.print(PASSIVE_EXPLANATION)
