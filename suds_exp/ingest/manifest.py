@@ -57,7 +57,9 @@ def read_manifest(path: Path, design: ExperimentDesign | None = None) -> dict[Pa
         if gait not in GAITS and not gait.lower().endswith(GAIT_FILE_SUFFIXES):
             raise IngestError(
                 f"{where}: unknown gait {gait!r}; expected one of {', '.join(GAITS)} "
-                "or a gait file's name (.csv, .toml)"
+                "or a gait file's name (.csv, .toml); declare your own gaits in a TOML "
+                "description given as experiment (docs/how-to/own-experiment.md)",
+                param="experiment",
             )
         try:
             freq = parse_frequency(row.frequency_hz)
