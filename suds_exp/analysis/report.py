@@ -15,7 +15,7 @@ import pandas as pd
 
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
-from suds_exp.analysis.design_report import write_design_report
+from suds_exp.analysis.design_report import skipped_html, write_design_report
 from suds_exp.analysis.findings import (
     PASSIVE_EXPLANATION,
     campaign_passive_information,
@@ -25,7 +25,14 @@ from suds_exp.analysis.findings import (
     passive_display,
     passive_reason,
 )
-from suds_exp.analysis.formatting import to_html, to_markdown, write_table
+from suds_exp.analysis.formatting import (
+    ReportTables,
+    not_computed_html,
+    to_html,
+    to_markdown,
+    write_missing,
+    write_table,
+)
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
@@ -37,29 +44,6 @@ from suds_exp.store import Store
 from suds_exp.store.files import check_writable
 
 _SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
-
-
-class ReportTables(dict):
-    """The report's tables by name (a dict of DataFrames), and ``missing``: the name of
-    each table that could not be computed -> why (one line), for the page to say."""
-
-    def __init__(self, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-        self.missing: dict[str, str] = {}
-
-    def attempt(self, names: str | tuple[str, ...], compute) -> bool:
-        """Store ``compute()`` (a DataFrame, or a tuple of them for several ``names``);
-        when the results cannot support it (`AnalysisError`), record why under each name
-        instead. Returns whether it was computed."""
-        names = (names,) if isinstance(names, str) else names
-        try:
-            got = compute()
-        except AnalysisError as exc:
-            for name in names:
-                self.missing[name] = str(exc)
-            return False
-        self.update(zip(names, got if len(names) > 1 else (got,), strict=True))
-        return True
 
 
 def report_tables(
@@ -236,7 +220,7 @@ def write_report(
         + _not_computed(tables.missing["findings"], files["findings"])
     )
     page = page.replace(_FINDINGS_SLOT, findings + _passive_html(passive, passive_files), 1)
-    page = page.replace(_SKIPPED_SLOT, _skipped_html(store, campaign), 1)
+    page = page.replace(_SKIPPED_SLOT, skipped_html(store, campaign), 1)
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")
     return index
@@ -256,21 +240,8 @@ def _report_folder(campaign: str, out_dir: str | Path | None) -> Path:
     return out
 
 
-def write_missing(missing: dict[str, str], out: Path) -> dict[str, dict[str, Path]]:
-    """For each table that could not be computed, ``<name>.md`` saying why (and no CSV,
-    so no stale one is read as current); returns each one's files by name."""
-    files = {}
-    for name, reason in missing.items():
-        md = out / f"{name}.md"
-        md.write_text(f"Not computed: {reason}\n", encoding="utf-8")
-        (out / f"{name}.csv").unlink(missing_ok=True)
-        files[name] = {"md": md}
-    return files
-
-
 def _not_computed(reason: str, files: dict[str, Path]) -> str:
-    """The paragraph a section shows in place of what could not be computed."""
-    return f"<p><b>Not computed:</b> {html.escape(reason)}. Files: {_files(files)}</p>"
+    return not_computed_html(reason, files)
 
 
 def _write_tables(tables: ReportTables, out: Path) -> dict[str, dict[str, Path]]:
@@ -328,20 +299,6 @@ def _passive_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
             to_html(passive_display(table)),
             f"<p>Files: {_files(files)}</p>",
         ]
-    )
-
-
-def _skipped_html(store: Store, campaign: str) -> str:
-    from suds_exp.campaign.definition import skipped_cells_text
-    from suds_exp.campaign.runner import load_stored_definition
-
-    # Results without a campaign row (e.g. inserted by hand) have nothing left out.
-    text = skipped_cells_text(load_stored_definition(store, campaign) or {})
-    if not text:
-        return ""
-    return (
-        "<p><b>Cells left out</b> (the campaign was run with <code>--skip-infeasible</code>; "
-        f"its data cannot supply them): {html.escape(text)}.</p>"
     )
 
 

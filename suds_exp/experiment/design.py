@@ -129,6 +129,13 @@ class ExperimentDesign:
         """The axes that make up a condition label (all but the frequency)."""
         return tuple(a for a in self.axes if a.name != FREQUENCY_AXIS)
 
+    @property
+    def added_labels(self) -> frozenset[str]:
+        """Labels of the conditions whose level code added after the declaration (its one
+        condition axis's `Axis.added`; none with several condition axes)."""
+        axes = self.label_axes
+        return frozenset(axes[0].added) if len(axes) == 1 else frozenset()
+
     def label(self, values: dict[str, str | float]) -> str:
         """A condition's label from its axis values: the value of the one label axis
         (the paper's: the gait), ``name=value`` joined by ``;`` for several, ``all`` for

@@ -3,7 +3,12 @@ one parsing core, keypoint files through `movement`, manifest, marker layout, an
 experiment description kept with the data (`stored_design`, `add_trial_levels`)."""
 
 from suds_exp.ingest.capture import Capture
-from suds_exp.ingest.experiment import add_trial_levels, design_for, stored_design
+from suds_exp.ingest.experiment import (
+    add_trial_levels,
+    design_for,
+    stored_design,
+    trial_level_axis,
+)
 from suds_exp.ingest.layout import DEFAULT_LAYOUT, ROLES, read_layout, trial_layout
 from suds_exp.ingest.listing import list_trials
 from suds_exp.ingest.load import IngestResult, ingest_file, ingest_paths
@@ -29,5 +34,6 @@ __all__ = [
     "read_layout",
     "read_manifest",
     "stored_design",
+    "trial_level_axis",
     "trial_layout",
 ]

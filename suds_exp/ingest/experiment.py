@@ -162,7 +162,7 @@ def add_trial_levels(
     """
     with store.write() as conn:
         design = read_design(conn)
-        target = _level_axis(design, axis)
+        target = trial_level_axis(design, axis)
         for trial_id, level in trials.items():
             problem = level_problem(level)
             if problem:
@@ -201,8 +201,10 @@ def add_trial_levels(
         return read_design(conn)
 
 
-def _level_axis(design: ExperimentDesign, axis: str | None) -> Axis:
-    """The axis new levels go on: ``axis`` or the design's one condition axis."""
+def trial_level_axis(design: ExperimentDesign, axis: str | None = None) -> Axis:
+    """The axis of ``design`` that `add_trial_levels` puts new levels on: ``axis`` or the
+    design's one condition axis; `IngestError` when there is none such (code that adds
+    trials checks this before it makes any)."""
     if axis is None:
         if len(design.label_axes) != 1:
             names = ", ".join(a.name for a in design.label_axes) or "none"
