@@ -382,3 +382,34 @@ def test_a_design_without_same_condition_pairs_reports_the_rest(own, tmp_path):
     # the rest is written: box plots and their numbers; the GLM (4 TLS results) says why
     assert (out / "categories.csv").is_file() and (out / "boxplot_gait.png").is_file()
     assert (out / "glm.md").read_text().startswith("Not computed: GLM: only 4 learner results")
+
+
+# -- the migration -------------------------------------------------------------------------
+
+
+def test_a_database_with_stored_axes_upgrades_to_a_stored_description(tmp_path):
+    from suds_exp.ingest import stored_design
+    from suds_exp.store.engine import make_engine
+
+    db = tmp_path / "old.duckdb"
+    store = Store(db)
+    store.upgrade(target=20)
+    engine = make_engine(db)
+    with engine.begin() as conn:
+        conn.exec_driver_sql(
+            "INSERT INTO experiment_axes VALUES ('gait', 0, 'unordered', '[\"a\", \"b\"]'), "
+            "('frequency_hz', 1, 'numeric', NULL)"
+        )
+        conn.exec_driver_sql(
+            "INSERT INTO experiment_levels VALUES ('gait', 'a', 0), ('gait', 'b', 1)"
+        )
+    engine.dispose()
+    # read before the upgrade (a read-only command on an old file): the axes are the design
+    assert [a.name for a in stored_design(Store(db)).axes] == ["gait", "frequency_hz"]
+    Store(db).upgrade()
+    rows = Store(db).query_df("SELECT id, source FROM experiment_description")
+    assert rows.id.tolist() == [1] and "before migration 021" in rows.source[0]
+    design = stored_design(Store(db))
+    assert design.axis("gait").levels == ("a", "b") and design.axis("gait").added == ()
+    levels = Store(db).query_df("SELECT level, added_by FROM experiment_levels ORDER BY level")
+    assert levels.level.tolist() == ["a", "b"] and levels.added_by.isna().all()
