@@ -259,6 +259,7 @@ def verify(db: Path, out: Path) -> None:
     )
 
 
+@pytest.mark.slow  # a verified design, a campaign, two reports and the findings: ~10-35 s
 def test_run_report_and_findings_after_verify_on_the_users_design(own_db, tmp_path):
     verify(own_db, tmp_path / "design")
     store = Store(own_db)

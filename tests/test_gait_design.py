@@ -133,6 +133,12 @@ def test_design_with_verify_stores_every_iteration_and_adds_trials(db, tmp_path)
     n_versions = Store(db).query_df("SELECT count(*) AS n FROM prep_versions")["n"].iloc[0]
     assert n_versions == 1
     assert (Path(doc["report"])).is_file()
+    # and are levels of the stored design (issue 39): a plain run and report take them
+    added = Store(db).query_df("SELECT level FROM experiment_levels WHERE added_by IS NOT NULL")
+    assert sorted(added.level) == [f"design-{doc['design_id']}-it{i}.toml" for i in (1, 2)]
+    ok("run", "after", "--models", "TLS", "--boots", "1", "--train-cycles", "3",
+       "--db", str(db), "-q")  # fmt: skip
+    ok("report", "after", "--out", str(tmp_path / "report"), "--db", str(db))
 
 
 def test_design_without_verify_changes_no_trials(db, tmp_path):
@@ -234,6 +240,7 @@ def test_connection_compares_the_learned_map_with_the_simulators(db, tmp_path):
     assert r.exit_code == 2 and "--directions" in r.output + (r.stderr or "")
 
 
+@pytest.mark.slow  # a verified design, a campaign, two reports and the findings: ~30 s
 def test_run_report_and_findings_work_after_verify(db, tmp_path):
     # issue 39: the verify trials were conditions outside the design; the next plain run
     # refused (a one-trial condition has no same-condition pair) and report crashed
