@@ -7,7 +7,7 @@
 CREATE TABLE experiment_description (
     id INTEGER PRIMARY KEY CHECK (id = 1),
     source VARCHAR NOT NULL,            -- the TOML file as named at ingest, or 'paper'
-    declared_at TIMESTAMP NOT NULL
+    created_at TIMESTAMP NOT NULL
 );
 
 -- A database that stored a design's axes before this migration: those axes are its

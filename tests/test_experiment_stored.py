@@ -130,8 +130,8 @@ def test_ingesting_again_with_the_same_description_duplicates_nothing(own_db, ow
     )
     for t in tables:
         after = store.query_df(f"SELECT * FROM {t} ORDER BY ALL")
-        assert after.drop(columns=["declared_at"], errors="ignore").equals(
-            before[t].drop(columns=["declared_at"], errors="ignore")
+        assert after.drop(columns=["created_at"], errors="ignore").equals(
+            before[t].drop(columns=["created_at"], errors="ignore")
         ), t
 
 
@@ -414,3 +414,22 @@ def test_a_database_with_stored_axes_upgrades_to_a_stored_description(tmp_path):
     assert design.axis("gait").levels == ("a", "b") and design.axis("gait").added == ()
     levels = Store(db).query_df("SELECT level, added_by FROM experiment_levels ORDER BY level")
     assert levels.level.tolist() == ["a", "b"] and levels.added_by.isna().all()
+
+
+def test_a_design_with_several_condition_axes_takes_no_added_trials(own_db):
+    from suds_exp.experiment import Axis, ExperimentDesign
+    from suds_exp.ingest import add_trial_levels, trial_level_axis
+
+    two = ExperimentDesign(
+        (Axis("gait", "unordered", ("a", "b")), Axis("surface", "unordered", ("sand", "mud"))),
+        "two.toml",
+    )
+    with pytest.raises(IngestError, match=r"^two\.toml: the design has 2 condition axes"):
+        trial_level_axis(two)
+    assert trial_level_axis(PAPER_DESIGN).name == "gait"
+    before = dump_db(own_db)
+    with pytest.raises(IngestError, match=r"no trial 999"):
+        add_trial_levels(Store(own_db), {999: "x.toml"}, added_by="a test loop")
+    with pytest.raises(IngestError, match=r"axis 'frequency_hz': expected the design's one"):
+        add_trial_levels(Store(own_db), {1: "x.toml"}, added_by="t", axis="frequency_hz")
+    assert_same_db(before, dump_db(own_db))

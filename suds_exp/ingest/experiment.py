@@ -211,8 +211,7 @@ def trial_level_axis(design: ExperimentDesign, axis: str | None = None) -> Axis:
             raise IngestError(
                 f"{design.source}: the design has {len(design.label_axes)} condition axes "
                 f"besides the frequency ({names}); a new trial's values along them are "
-                "unknown, so it cannot be one of its conditions",
-                param="axis",
+                "unknown, so it cannot be one of its conditions"
             )
         return design.label_axes[0]
     target = design.axis(axis) if axis in design.names else None
