@@ -139,6 +139,21 @@ def test_design_with_verify_stores_every_iteration_and_adds_trials(db, tmp_path)
     ok("run", "after", "--models", "TLS", "--boots", "1", "--train-cycles", "3",
        "--db", str(db), "-q")  # fmt: skip
     ok("report", "after", "--out", str(tmp_path / "report"), "--db", str(db))
+    # SQL (results_axis_pairs) and Python classify the pairs alike; a designed gait has no
+    # place on the ordered gait axis: same as itself, else far
+    from suds_exp.analysis import load_results
+    from suds_exp.analysis.design_tables import label_pairs
+    from suds_exp.ingest import stored_design
+
+    store = Store(db)
+    py = label_pairs(load_results(store, "after"), stored_design(store))
+    sql = store.query_df(
+        "SELECT train_gait, test_gait, category FROM results_axis_pairs "
+        "WHERE campaign = 'after' AND axis = 'gait'"
+    )
+    pairs = {tuple(r) for r in py[["train_gait", "test_gait", "gait_pair"]].to_numpy()}
+    assert pairs == {tuple(r) for r in sql.to_numpy()}
+    assert {c for t, d, c in pairs if t != d and ".toml" in t + d} == {"far"}
 
 
 def test_design_without_verify_changes_no_trials(db, tmp_path):

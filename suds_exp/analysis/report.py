@@ -217,7 +217,7 @@ def write_report(
         _findings_html(tables["findings"], files["findings"])
         if "findings" in tables
         else '<h2 id="findings">The paper\'s findings</h2>\n'
-        + _not_computed(tables.missing["findings"], files["findings"])
+        + not_computed_html(tables.missing["findings"], files["findings"])
     )
     page = page.replace(_FINDINGS_SLOT, findings + _passive_html(passive, passive_files), 1)
     page = page.replace(_SKIPPED_SLOT, skipped_html(store, campaign), 1)
@@ -238,10 +238,6 @@ def _report_folder(campaign: str, out_dir: str | Path | None) -> Path:
     out = Path(out_dir)
     check_writable(out, "out: report folder", AnalysisError, param="out")
     return out
-
-
-def _not_computed(reason: str, files: dict[str, Path]) -> str:
-    return not_computed_html(reason, files)
 
 
 def _write_tables(tables: ReportTables, out: Path) -> dict[str, dict[str, Path]]:
@@ -365,7 +361,7 @@ def _categories_section(tables, figures, files) -> list[str]:
         parts.append(f'<img src="{esc(figures[key].name)}" alt="{esc(key)}">')
     parts.append("<h3>Numbers behind the box plots (ln of mm/s)</h3>")
     if "categories" not in tables:
-        return [*parts, _not_computed(tables.missing["categories"], files["categories"])]
+        return [*parts, not_computed_html(tables.missing["categories"], files["categories"])]
     parts += [
         f"<p>Files: {_files(files['categories'])}</p>",
         to_html(tables["categories"], 3),
@@ -378,7 +374,7 @@ def _glm_section(tables, files, size) -> list[str]:
     if "glm" not in tables:
         return [
             '<h2 id="glm">2. GLM of log RMS error</h2>',
-            _not_computed(tables.missing["glm"], files["glm"]),
+            not_computed_html(tables.missing["glm"], files["glm"]),
         ]
     glm = tables["glm"]
     refs = glm.attrs["reference"]
@@ -447,7 +443,7 @@ def _spread_section(tables, figures, files, pairs) -> list[str]:
     else:
         parts.append(
             f"<p>No spread table and no sample-efficiency figure ({esc(pairs)} pairs).</p>"
-            + _not_computed(tables.missing["iqr"], files["iqr"])
+            + not_computed_html(tables.missing["iqr"], files["iqr"])
         )
 
     return parts
@@ -473,7 +469,7 @@ def _paper_section(tables, files) -> list[str]:
             f"<p>Files: {_files(files['compare_iqr'])}</p>",
         ]
     elif "compare_glm" in tables.missing:
-        parts.append(_not_computed(tables.missing["compare_glm"], files["compare_glm"]))
+        parts.append(not_computed_html(tables.missing["compare_glm"], files["compare_glm"]))
     else:
         parts.append(
             "<p>The paper's tables were not found (pass <code>--paper DIR</code>); "
