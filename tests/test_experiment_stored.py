@@ -428,6 +428,10 @@ def test_a_design_with_several_condition_axes_takes_no_added_trials(own_db):
         trial_level_axis(two)
     assert trial_level_axis(PAPER_DESIGN).name == "gait"
     before = dump_db(own_db)
+    with pytest.raises(
+        IngestError, match=r"^trial 1 is stored as '(glide|crawl|turn)', not 'x.toml'"
+    ):
+        add_trial_levels(Store(own_db), {1: "x.toml"}, added_by="a test loop")
     with pytest.raises(IngestError, match=r"no trial 999"):
         add_trial_levels(Store(own_db), {999: "x.toml"}, added_by="a test loop")
     with pytest.raises(IngestError, match=r"axis 'frequency_hz': expected the design's one"):

@@ -136,10 +136,11 @@ def add_trial_levels(
     loop), after they are ingested: each trial's ``level`` (e.g. the gait file's name)
     becomes a level of the stored design's condition ``axis`` (default: its one axis
     besides the frequency), recorded as added by ``added_by`` (stored in
-    ``experiment_levels.added_by``); the trial's label is set to that level and its values
-    (the level and its frequency, when the frequency is an axis) are stored in
-    ``trial_conditions``. A paper database gets the paper's design stored first, with its
-    trials' values. Calling it again for the same trials changes nothing.
+    ``experiment_levels.added_by``); the trial's label must be that level (the name it was
+    ingested with; a trial ingested without a condition gets it) and its values (the level
+    and its frequency, when the frequency is an axis) are stored in ``trial_conditions``.
+    A paper database gets the paper's design stored first, with its trials' values.
+    Calling it again for the same trials changes nothing.
 
     Parameters
     ----------
@@ -171,15 +172,24 @@ def add_trial_levels(
                     param="trials",
                 )
         found = {
-            int(r[0]): r[1]
+            int(r[0]): (r[1], r[2])
             for r in conn.exec_driver_sql(
-                "SELECT id, frequency_hz FROM trials WHERE list_contains(?, id)",
+                "SELECT id, frequency_hz, gait FROM trials WHERE list_contains(?, id)",
                 ([int(t) for t in trials],),
             ).fetchall()
         }
         missing = sorted(set(map(int, trials)) - set(found))
         if missing:
             raise IngestError(f"trials: no trial {missing[0]} in the database", param="trials")
+        for trial_id, level in trials.items():
+            label = found[int(trial_id)][1]
+            # a label is what the trial was ingested as: never overwritten, so never lost
+            if label is not None and label != level:
+                raise IngestError(
+                    f"trial {trial_id} is stored as {label!r}, not {level!r}; a trial's "
+                    "level is the name it was ingested with",
+                    param="trials",
+                )
         described = conn.exec_driver_sql("SELECT count(*) FROM experiment_description")
         if not described.fetchone()[0]:
             _store_paper(conn)
@@ -192,11 +202,16 @@ def add_trial_levels(
             )
         for trial_id, level in trials.items():
             trial_id = int(trial_id)
-            conn.exec_driver_sql("UPDATE trials SET gait = ? WHERE id = ?", (level, trial_id))
+            # a trial ingested without a condition gets the level as its label
+            conn.exec_driver_sql(
+                "UPDATE trials SET gait = ? WHERE id = ? AND gait IS NULL", (level, trial_id)
+            )
+            # its values along the design: the same as any stored ones (same label and
+            # frequency), so calling again rewrites them unchanged
             conn.exec_driver_sql("DELETE FROM trial_conditions WHERE trial_id = ?", (trial_id,))
             values = [(target.name, level)]
             if FREQUENCY_AXIS in design.names:
-                values.append((FREQUENCY_AXIS, round(float(found[trial_id]), 6)))
+                values.append((FREQUENCY_AXIS, round(float(found[trial_id][0]), 6)))
             store_values(conn, trial_id, values)
         return read_design(conn)
 
