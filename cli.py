@@ -495,7 +495,8 @@ def report(
         Path | None, typer.Option(help="Folder of the paper's glm_table.csv and iqr_table.csv.")
     ] = None,
     experiment: Annotated[
-        Path | None, typer.Option(help="TOML of the condition axes (default: the paper's).")
+        Path | None,
+        typer.Option(help="TOML of the condition axes (default: the one stored at ingest)."),
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -508,7 +509,7 @@ def report(
     from suds_exp.commands.report import report_document
     from suds_exp.experiment import load_design
 
-    design = load_design(experiment)
+    design = load_design(experiment) if experiment is not None else None
     index = write_report(
         open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs, design=design
     )

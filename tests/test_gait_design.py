@@ -138,6 +138,27 @@ def test_design_with_verify_stores_every_iteration_and_adds_trials(db, tmp_path)
     n_versions = Store(db).query_df("SELECT count(*) AS n FROM prep_versions")["n"].iloc[0]
     assert n_versions == 1
     assert (Path(doc["report"])).is_file()
+    # and are levels of the stored design (issue 39): a plain run and report take them
+    added = Store(db).query_df("SELECT level FROM experiment_levels WHERE added_by IS NOT NULL")
+    assert sorted(added.level) == [f"design-{doc['design_id']}-it{i}.toml" for i in (1, 2)]
+    ok("run", "after", "--models", "TLS", "--boots", "1", "--train-cycles", "3",
+       "--db", str(db), "-q")  # fmt: skip
+    ok("report", "after", "--out", str(tmp_path / "report"), "--db", str(db))
+    # SQL (results_axis_pairs) and Python classify the pairs alike; a designed gait has no
+    # place on the ordered gait axis: same as itself, else far
+    from suds_exp.analysis import load_results
+    from suds_exp.analysis.design_tables import label_pairs
+    from suds_exp.ingest import stored_design
+
+    store = Store(db)
+    py = label_pairs(load_results(store, "after"), stored_design(store))
+    sql = store.query_df(
+        "SELECT train_gait, test_gait, category FROM results_axis_pairs "
+        "WHERE campaign = 'after' AND axis = 'gait'"
+    )
+    pairs = {tuple(r) for r in py[["train_gait", "test_gait", "gait_pair"]].to_numpy()}
+    assert pairs == {tuple(r) for r in sql.to_numpy()}
+    assert {c for t, d, c in pairs if t != d and ".toml" in t + d} == {"far"}
 
 
 def test_design_without_verify_changes_no_trials(db, tmp_path):
@@ -237,3 +258,25 @@ def test_connection_compares_the_learned_map_with_the_simulators(db, tmp_path):
         app, ["gait", "connection", "--out", str(out), "--directions", "all", "--db", str(db)]
     )
     assert r.exit_code == 2 and "--directions" in r.output + (r.stderr or "")
+
+
+@pytest.mark.slow  # a verified design, a campaign, two reports and the findings: ~30 s
+def test_run_report_and_findings_work_after_verify(db, tmp_path):
+    # issue 39: the verify trials were conditions outside the design; the next plain run
+    # refused (a one-trial condition has no same-condition pair) and report crashed
+    out = str(tmp_path / "out")
+    ok("gait", "design", "--iterations", "1", "--verify", "--order", "1", "--out", out,
+       "--db", str(db), "--json")  # fmt: skip
+    levels = Store(db).query_df(
+        "SELECT axis, level FROM experiment_levels WHERE added_by IS NOT NULL"
+    )
+    assert levels.values.tolist() == [["gait", "design-1-it1.toml"]]
+    ok("run", "after", "--models", "phase-only,TLS", "--boots", "2", "--train-cycles", "3",
+       "--db", str(db), "-q")  # fmt: skip
+    out = tmp_path / "report"
+    ok("report", "after", "--out", str(out), "--db", str(db))
+    assert "design-1-it1.toml" in (out / "index.html").read_text()
+    paper = Path(__file__).resolve().parents[1] / "suds_exp" / "experiment" / "paper.toml"
+    ok("report", "after", "--out", str(tmp_path / "r2"), "--experiment", str(paper),
+       "--db", str(db))
+    ok("findings", "after", "--boot", "10", "--db", str(db))

@@ -20,7 +20,13 @@ from suds_exp.analysis.design_tables import (
     design_slope_table,
     label_pairs,
 )
-from suds_exp.analysis.formatting import to_html, write_table
+from suds_exp.analysis.formatting import (
+    ReportTables,
+    not_computed_html,
+    to_html,
+    write_missing,
+    write_table,
+)
 from suds_exp.analysis.queries import load_results
 from suds_exp.experiment import ExperimentDesign
 from suds_exp.store import Store
@@ -47,28 +53,34 @@ def write_design_report(
     condition), ``categories``, ``glm``, ``glm_rmse``, ``iqr`` and ``slopes`` as ``.csv``
     and ``.md``, and ``index.html`` into ``out``; returns the page.
     A design without axes (recordings without conditions, run by trial) has only the IQR
-    table, and the page says what the analysis then means (`BY_TRIAL_MEANING`)."""
+    table, and the page says what the analysis then means (`BY_TRIAL_MEANING`). A table
+    the results cannot support (too few for a GLM, no same-condition pairs) is written as
+    a Markdown note saying why (`write_missing`), and the page says it in its place."""
     results = load_results(store, campaign)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)
-    tables = {}
+    tables = ReportTables()
     if design.axes:
-        tables["categories"] = axis_category_table(results, design, size)
-        tables["glm"] = design_glm_table(results, design, size)
-        tables["glm_rmse"] = design_glm_table(results, design, size, response="rmse")
-    tables["iqr"] = design_iqr_table(results, design)
-    tables["slopes"] = design_slope_table(results, design)
+        tables.attempt("categories", lambda: axis_category_table(results, design, size))
+        tables.attempt("glm", lambda: design_glm_table(results, design, size))
+        tables.attempt("glm_rmse", lambda: design_glm_table(results, design, size, response="rmse"))
+    tables.attempt(
+        ("iqr", "slopes"),
+        lambda: (design_iqr_table(results, design), design_slope_table(results, design)),
+    )
     figures = plots.axis_boxplots(label_pairs(results, design), design, out, size)
-    iqr, slopes = (
-        t.assign(
-            panel=[f"{c} @ {f:g} Hz" for c, f in zip(t.condition, t.frequency_hz, strict=True)]
+    if "iqr" in tables:
+        iqr, slopes = (
+            t.assign(
+                panel=[f"{c} @ {f:g} Hz" for c, f in zip(t.condition, t.frequency_hz, strict=True)]
+            )
+            for t in (tables["iqr"], tables["slopes"])
         )
-        for t in (tables["iqr"], tables["slopes"])
-    )
-    figures["sample_efficiency"] = plots.efficiency_figure(
-        iqr, slopes, out / "sample_efficiency.png", panel="panel"
-    )
+        figures["sample_efficiency"] = plots.efficiency_figure(
+            iqr, slopes, out / "sample_efficiency.png", panel="panel"
+        )
     files = {name: write_table(frame, out, name, 3) for name, frame in tables.items()}
+    files.update(write_missing(tables.missing, out))
     axes = ", ".join(f"{a.name} ({a.kind})" for a in design.axes) or "none"
     parts = [
         "<!doctype html><html><head><meta charset='utf-8'>",
@@ -76,12 +88,18 @@ def write_design_report(
         f"<h1>Campaign {html.escape(campaign)}</h1>",
         f"<p>Experiment {html.escape(design.source)}: axes {html.escape(axes)}; "
         f"{len(results)} results; box plots and GLMs at {size} training cycles.</p>",
+        _added_html(design),
+        skipped_html(store, campaign),
     ]
     if design.by_trial:
         parts.append(f"<p>{html.escape(BY_TRIAL_MEANING)}</p>")
     for name, path in figures.items():
         parts.append(f"<h2>{html.escape(name)}</h2><img src='{path.name}' alt='{name}'>")
-    for name, frame in tables.items():
+    for name in files:
+        if name in tables.missing:
+            parts.append(f"<h2>{name}</h2>{not_computed_html(tables.missing[name], files[name])}")
+            continue
+        frame = tables[name]
         links = " ".join(f"<a href='{p.name}'>{p.suffix[1:]}</a>" for p in files[name].values())
         note = ""
         if name.startswith("glm"):
@@ -96,3 +114,33 @@ def write_design_report(
     index = out / "index.html"
     index.write_text("\n".join(parts), encoding="utf-8")
     return index
+
+
+def _added_html(design: ExperimentDesign) -> str:
+    """Names the levels code added to the design after its declaration, if any."""
+    added = [(a.name, v) for a in design.axes for v in a.added]
+    if not added:
+        return ""
+    text = ", ".join(f"{name}={level}" for name, level in added)
+    return (
+        "<p>Levels added after the declaration (by the code that added their trials, e.g. "
+        f"a gait design's verify step; on an ordered axis a pair with one is same or far): "
+        f"{html.escape(text)}.</p>"
+    )
+
+
+def skipped_html(store: Store, campaign: str) -> str:
+    """The page's note of the (condition, training cycles) cells the campaign left out,
+    or nothing."""
+    from suds_exp.campaign.definition import skipped_cells_text
+    from suds_exp.campaign.runner import load_stored_definition
+
+    # Results without a campaign row (e.g. inserted by hand) have nothing left out.
+    text = skipped_cells_text(load_stored_definition(store, campaign) or {})
+    if not text:
+        return ""
+    return (
+        "<p><b>Cells left out</b> (its data cannot supply them: the campaign was run with "
+        "<code>--skip-infeasible</code>, or the condition was added to the design by a loop "
+        f"with too few trials): {html.escape(text)}.</p>"
+    )

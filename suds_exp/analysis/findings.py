@@ -36,6 +36,7 @@ from threadpoolctl import threadpool_limits
 from suds_exp.analysis.categories import main_cycles
 from suds_exp.analysis.glm import formula_design, glm_formulas, glm_frame
 from suds_exp.errors import AnalysisError
+from suds_exp.experiment import is_paper
 from suds_exp.models.registry import LEARNERS
 
 #: The learners' roles in the findings (names as stored in ``results.model``).
@@ -645,10 +646,20 @@ def findings_summary(table: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def findings(store, campaign: str, **kwargs) -> pd.DataFrame:
+#: What the findings say on a design other than the paper's (``{source}``: its file).
+DESIGN_CAVEAT = (
+    "F1-F10 assume the paper's design (its gaits S+ < S- < O < D- < D+ and frequencies); "
+    "{source} is another, so only the statistics its results can measure are shown"
+)
+
+
+def findings(store, campaign: str, design=None, **kwargs) -> pd.DataFrame:
     """`findings_table` of campaign ``campaign`` in ``store`` (keyword options as there,
-    except that ``n_boot`` must be >= 1: a verdict needs its interval)."""
+    except that ``n_boot`` must be >= 1: a verdict needs its interval). ``design``: the
+    experiment (default the one stored with the data, `suds_exp.ingest.design_for`); on
+    one other than the paper's the table is `for_design`'s."""
     from suds_exp.analysis.queries import load_results
+    from suds_exp.ingest import design_for
 
     n_boot = kwargs.get("n_boot", 1)
     if isinstance(n_boot, bool) or not isinstance(n_boot, int) or n_boot < 1:
@@ -657,7 +668,24 @@ def findings(store, campaign: str, **kwargs) -> pd.DataFrame:
             "the verdicts rest on)",
             param="n_boot",
         )
-    return findings_table(load_results(store, campaign), campaign=campaign, **kwargs)
+    table = findings_table(load_results(store, campaign), campaign=campaign, **kwargs)
+    design = design_for(store, design)
+    return table if is_paper(design) else for_design(table, design.source)
+
+
+def for_design(table: pd.DataFrame, source: str) -> pd.DataFrame:
+    """The findings ``table`` on a design other than the paper's (named ``source``):
+    only the statistics that could be measured, with ``attrs`` ``design`` (``source``),
+    ``caveat`` (`DESIGN_CAVEAT`) and ``left_out`` (``"<id>: <why>"`` for each other)."""
+    measured = table["verdict"] != "not measurable"
+    out = table[measured].reset_index(drop=True)
+    out.attrs = {
+        **table.attrs,
+        "design": source,
+        "caveat": DESIGN_CAVEAT.format(source=source),
+        "left_out": [f"{r.id}: {r.reason}" for r in table[~measured].itertuples()],
+    }
+    return out
 
 
 def findings_display(table: pd.DataFrame, digits: int = 2) -> pd.DataFrame:
@@ -861,10 +889,29 @@ def campaign_passive_information(store, campaign: str, **kwargs) -> pd.DataFrame
         samples = get_version(store, row["prep_version"].iloc[0]).samples() if len(row) else None
     except SudsError:
         samples = None
-    if samples is None or samples.empty or not any(c.startswith("rp_") for c in samples):
+    if samples is None or samples.empty:
         # results without stored samples (imported, synthetic): nothing to measure
-        return pd.DataFrame(columns=PASSIVE_COLUMNS)
-    return passive_information(samples, **kwargs)
+        return _no_passive("the campaign's samples are not stored")
+    if not any(c.startswith("rp_") for c in samples):
+        return _no_passive("the samples have no passive shape (rp_*)")
+    table = passive_information(samples, **kwargs)
+    if table.empty:
+        return _no_passive(
+            f"no condition has two trials at one frequency in the {len(samples):,} stored "
+            "samples (a pair fits on one trial and tests on another)"
+        )
+    return table
+
+
+def _no_passive(reason: str) -> pd.DataFrame:
+    table = pd.DataFrame(columns=PASSIVE_COLUMNS)
+    table.attrs["reason"] = reason
+    return table
+
+
+def passive_reason(table: pd.DataFrame) -> str:
+    """Why an empty passive-information table (`campaign_passive_information`) is empty."""
+    return table.attrs.get("reason", "no pair of trials to measure it on")
 
 
 def passive_display(table: pd.DataFrame) -> pd.DataFrame:

@@ -1,4 +1,5 @@
-"""Writing tables as CSV, Markdown and HTML fragments."""
+"""Writing tables as CSV, Markdown and HTML fragments, and saying which could not be
+computed (`ReportTables`, `write_missing`)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from suds_exp.errors import AnalysisError
 
 
 def _cell(value, digits: int) -> str:
@@ -67,3 +70,46 @@ def write_table(
         markdown if markdown is not None else to_markdown(frame, digits), encoding="utf-8"
     )
     return {"csv": csv, "md": md}
+
+
+class ReportTables(dict):
+    """The report's tables by name (a dict of DataFrames), and ``missing``: the name of
+    each table that could not be computed -> why (one line), for the page to say."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.missing: dict[str, str] = {}
+
+    def attempt(self, names: str | tuple[str, ...], compute) -> bool:
+        """Store ``compute()`` (a DataFrame, or a tuple of them for several ``names``);
+        when the results cannot support it (`AnalysisError`), record why under each name
+        instead. Returns whether it was computed."""
+        names = (names,) if isinstance(names, str) else names
+        try:
+            got = compute()
+        except AnalysisError as exc:
+            for name in names:
+                self.missing[name] = str(exc)
+            return False
+        self.update(zip(names, got if len(names) > 1 else (got,), strict=True))
+        return True
+
+
+def write_missing(missing: dict[str, str], out: Path) -> dict[str, dict[str, Path]]:
+    """For each table that could not be computed, ``<name>.md`` saying why (and no CSV,
+    so no stale one is read as current); returns each one's files by name."""
+    files = {}
+    for name, reason in missing.items():
+        md = out / f"{name}.md"
+        md.write_text(f"Not computed: {reason}\n", encoding="utf-8")
+        (out / f"{name}.csv").unlink(missing_ok=True)
+        files[name] = {"md": md}
+    return files
+
+
+def not_computed_html(reason: str, files: dict[str, Path]) -> str:
+    """The paragraph a report section shows in place of what could not be computed."""
+    links = " ".join(
+        f'<a href="{html.escape(p.name)}">{html.escape(p.name)}</a>' for p in files.values()
+    )
+    return f"<p><b>Not computed:</b> {html.escape(reason)}. Files: {links}</p>"

@@ -15,7 +15,7 @@ import pandas as pd
 
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
-from suds_exp.analysis.design_report import write_design_report
+from suds_exp.analysis.design_report import skipped_html, write_design_report
 from suds_exp.analysis.findings import (
     PASSIVE_EXPLANATION,
     campaign_passive_information,
@@ -23,14 +23,23 @@ from suds_exp.analysis.findings import (
     findings_headline,
     findings_table,
     passive_display,
+    passive_reason,
 )
-from suds_exp.analysis.formatting import to_html, to_markdown, write_table
+from suds_exp.analysis.formatting import (
+    ReportTables,
+    not_computed_html,
+    to_html,
+    to_markdown,
+    write_missing,
+    write_table,
+)
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import ExperimentDesign, is_paper
+from suds_exp.ingest import design_for
 from suds_exp.store import Store
 from suds_exp.store.files import check_writable
 
@@ -44,7 +53,7 @@ def report_tables(
     upper_from: int | None = None,
     pairs: str = "same-condition",
     findings_boot: int = 400,
-) -> dict[str, pd.DataFrame]:
+) -> ReportTables:
     """Every table of the report, from labelled results (see `load_results`).
 
     Keys: ``findings`` (the paper's findings F1-F10, see `findings_table`, with
@@ -53,23 +62,25 @@ def report_tables(
     and, when the paper's tables are found (in ``paper_dir``, which must hold them, or
     else in the default folder, which may not), ``compare_glm``
     (both scales, column ``scale``), ``compare_iqr`` and ``agreement``. A part that the
-    results cannot support (no same-condition pairs, say) is left out. ``pairs``: see
-    `iqr_table`.
+    results cannot support (no same-condition pairs, too few results for a GLM) is left
+    out, and ``missing`` says why. ``pairs``: see `iqr_table`.
     """
     if pairs not in PAIRS:
         raise AnalysisError(f"pairs {pairs}: expected one of {', '.join(PAIRS)}", param="pairs")
-    tables: dict[str, pd.DataFrame] = {
-        "findings": findings_table(results, n_boot=findings_boot, upper_from=upper_from),
-        "categories": category_table(results, n_cycles),
-    }
-    tables["glm"] = glm_table(results, n_cycles, response="log")
-    tables["glm_rmse"] = glm_table(results, n_cycles, response="rmse")
-    try:
-        tables["iqr"] = iqr_table(results, pairs)
-    except AnalysisError:  # no such pairs: the report says so instead
-        pass
-    else:
-        tables["slopes"] = slope_table(results, upper_from, pairs)
+    tables = ReportTables()
+    tables.attempt(
+        "findings", lambda: findings_table(results, n_boot=findings_boot, upper_from=upper_from)
+    )
+    tables.attempt("categories", lambda: category_table(results, n_cycles))
+    tables.attempt("glm", lambda: glm_table(results, n_cycles, response="log"))
+    tables.attempt("glm_rmse", lambda: glm_table(results, n_cycles, response="rmse"))
+    tables.attempt(
+        ("iqr", "slopes"),
+        lambda: (iqr_table(results, pairs), slope_table(results, upper_from, pairs)),
+    )
+    if "glm" not in tables:  # the comparison is of GLM terms and IQRs: nothing to compare
+        tables.missing["compare_glm"] = tables.missing["agreement"] = tables.missing["glm"]
+        return tables
     try:
         paper_glm, paper_iqr = paper_table("glm", paper_dir), paper_table("iqr", paper_dir)
     except AnalysisError:
@@ -169,14 +180,18 @@ def write_report(
     pairs : {"same-condition", "same-frequency"}
         Train/test pairs of the spread table and sample-efficiency figure (see `iqr_table`).
     design : ExperimentDesign, optional
-        The experiment's axes (`suds_exp.experiment`); None or the paper's: this report.
-        Another design writes `suds_exp.analysis.design_report.write_design_report`.
+        The experiment's axes (`suds_exp.experiment`); None: the design stored with the
+        data at ingest (`suds_exp.ingest.stored_design`), which a design given here
+        overrides (keeping the levels code added to it, `suds_exp.ingest.design_for`).
+        The paper's: this report; another writes
+        `suds_exp.analysis.design_report.write_design_report`.
 
     Returns
     -------
     Path of ``index.html``.
     """
     out = _report_folder(campaign, out_dir)
+    design = design_for(store, design)
     if not is_paper(design):
         return write_design_report(store, campaign, design, out, n_cycles)
     results = load_results(store, campaign)
@@ -198,13 +213,14 @@ def write_report(
         if not passive.empty
         else {}
     )
-    page = page.replace(
-        _FINDINGS_SLOT,
+    findings = (
         _findings_html(tables["findings"], files["findings"])
-        + _passive_html(passive, passive_files),
-        1,
+        if "findings" in tables
+        else '<h2 id="findings">The paper\'s findings</h2>\n'
+        + not_computed_html(tables.missing["findings"], files["findings"])
     )
-    page = page.replace(_SKIPPED_SLOT, _skipped_html(store, campaign), 1)
+    page = page.replace(_FINDINGS_SLOT, findings + _passive_html(passive, passive_files), 1)
+    page = page.replace(_SKIPPED_SLOT, skipped_html(store, campaign), 1)
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")
     return index
@@ -224,10 +240,11 @@ def _report_folder(campaign: str, out_dir: str | Path | None) -> Path:
     return out
 
 
-def _write_tables(tables: dict[str, pd.DataFrame], out: Path) -> dict[str, dict[str, Path]]:
+def _write_tables(tables: ReportTables, out: Path) -> dict[str, dict[str, Path]]:
     """Each report table as CSV and Markdown in ``out`` (the IQR table one Markdown
-    table per frequency); returns each table's files by name."""
-    files: dict[str, dict[str, Path]] = {}
+    table per frequency), and a Markdown note for each missing one (`write_missing`);
+    returns each table's files by name."""
+    files: dict[str, dict[str, Path]] = write_missing(tables.missing, out)
     digits = {"compare_iqr": 2, "iqr": 3, "slopes": 3, "agreement": 2}
     for name, frame in tables.items():
         md = to_markdown(findings_display(frame)) if name == "findings" else None
@@ -269,7 +286,7 @@ def _passive_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
     """The passive-information section (`passive_information`) beside the findings."""
     head = '<h3 id="passive-information">What the passive shape adds</h3>'
     if table.empty:
-        return f"\n{head}\n<p>Not measurable: the campaign's samples are not stored.</p>"
+        return f"\n{head}\n<p>Not measurable: {html.escape(passive_reason(table))}.</p>"
     return "\n".join(
         [
             "",
@@ -278,20 +295,6 @@ def _passive_html(table: pd.DataFrame, files: dict[str, Path]) -> str:
             to_html(passive_display(table)),
             f"<p>Files: {_files(files)}</p>",
         ]
-    )
-
-
-def _skipped_html(store: Store, campaign: str) -> str:
-    from suds_exp.campaign.definition import skipped_cells_text
-    from suds_exp.campaign.runner import load_stored_definition
-
-    # Results without a campaign row (e.g. inserted by hand) have nothing left out.
-    text = skipped_cells_text(load_stored_definition(store, campaign) or {})
-    if not text:
-        return ""
-    return (
-        "<p><b>Cells left out</b> (the campaign was run with <code>--skip-infeasible</code>; "
-        f"its data cannot supply them): {html.escape(text)}.</p>"
     )
 
 
@@ -356,8 +359,10 @@ def _categories_section(tables, figures, files) -> list[str]:
     parts = []
     for key in ("boxplot_frequency", "boxplot_gait", "boxplot_combined"):
         parts.append(f'<img src="{esc(figures[key].name)}" alt="{esc(key)}">')
+    parts.append("<h3>Numbers behind the box plots (ln of mm/s)</h3>")
+    if "categories" not in tables:
+        return [*parts, not_computed_html(tables.missing["categories"], files["categories"])]
     parts += [
-        "<h3>Numbers behind the box plots (ln of mm/s)</h3>",
         f"<p>Files: {_files(files['categories'])}</p>",
         to_html(tables["categories"], 3),
     ]
@@ -366,6 +371,11 @@ def _categories_section(tables, figures, files) -> list[str]:
 
 def _glm_section(tables, files, size) -> list[str]:
     esc = html.escape
+    if "glm" not in tables:
+        return [
+            '<h2 id="glm">2. GLM of log RMS error</h2>',
+            not_computed_html(tables.missing["glm"], files["glm"]),
+        ]
     glm = tables["glm"]
     refs = glm.attrs["reference"]
     parts = [
@@ -432,8 +442,8 @@ def _spread_section(tables, figures, files, pairs) -> list[str]:
         ]
     else:
         parts.append(
-            f"<p>No results with {esc(pairs)} pairs: no spread table and no "
-            "sample-efficiency figure.</p>"
+            f"<p>No spread table and no sample-efficiency figure ({esc(pairs)} pairs).</p>"
+            + not_computed_html(tables.missing["iqr"], files["iqr"])
         )
 
     return parts
@@ -458,6 +468,8 @@ def _paper_section(tables, files) -> list[str]:
             to_html(tables["compare_iqr"], 2),
             f"<p>Files: {_files(files['compare_iqr'])}</p>",
         ]
+    elif "compare_glm" in tables.missing:
+        parts.append(not_computed_html(tables.missing["compare_glm"], files["compare_glm"]))
     else:
         parts.append(
             "<p>The paper's tables were not found (pass <code>--paper DIR</code>); "

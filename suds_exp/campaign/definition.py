@@ -152,12 +152,20 @@ class Plan:
 
 
 def make_plan(
-    name: str, options: CampaignOptions, available: list[Condition], bank_for
+    name: str,
+    options: CampaignOptions,
+    available: list[Condition],
+    bank_for,
+    added: frozenset[str] = frozenset(),
 ) -> tuple[Plan, SampleBank]:
     """Resolve ``options`` (already merged) against the conditions in the samples.
 
     ``bank_for(conditions)`` builds the `SampleBank` of those conditions; the plan's
-    definition records its decimation and the trials used.
+    definition records its decimation and the trials used. ``added``: labels of
+    conditions that code added to the design after its declaration
+    (`suds_exp.experiment.ExperimentDesign.added_labels`, e.g. one verify trial of a
+    designed gait each); their cells the data cannot supply are left out, as
+    ``skip_infeasible`` leaves out every condition's.
     """
     if not name or not name.strip():
         raise CampaignError("campaign NAME must not be empty")
@@ -195,6 +203,11 @@ def make_plan(
         # no such key) still compare equal when they are continued.
         stored_options["skip_infeasible"] = True
         skipped = infeasible_cells(bank, train, test, int(options.train_cycles), sweep)
+    elif added:
+        # an added condition holds the few trials a loop ran (one per designed gait), not
+        # the repeats a declared one has: what it cannot supply is left out, and said
+        cells = infeasible_cells(bank, train, test, int(options.train_cycles), sweep)
+        skipped = [cell for cell in cells if cell[0][0] in added]
     definition = {
         "version": DEFINITION_VERSION,
         "options": stored_options,
@@ -203,7 +216,7 @@ def make_plan(
         "decimation": {f"{k:g}": v for k, v in bank.decimation.items()},
         "trials": bank.describe(),
     }
-    if options.skip_infeasible:
+    if options.skip_infeasible or skipped:
         definition["skipped_cells"] = [
             {"condition": format_condition(c), "n_cycles": n, "pairs": scope}
             for c, n, scope in skipped

@@ -52,6 +52,7 @@ from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
 from suds_exp.errors import CampaignError, ClusterLostError, StoreError
+from suds_exp.ingest import stored_design
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 from suds_exp.store.definition import check_same
@@ -263,7 +264,13 @@ def run_campaign(
         stored, done = stored_state(store, name)
         merged = merge_stored(options, stored)
         prep, samples = campaign_samples(store, merged.prep, samples)
-        plan, bank = plan_campaign(name, dataclasses.replace(merged, prep=prep), stored, samples)
+        plan, bank = plan_campaign(
+            name,
+            dataclasses.replace(merged, prep=prep),
+            stored,
+            samples,
+            stored_design(store).added_labels,
+        )
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
             plan, done, chunk_jobs or _default_chunk(plan, n_workers)
@@ -338,14 +345,22 @@ def campaign_samples(
 
 
 def plan_campaign(
-    name: str, options: CampaignOptions, stored: dict | None, samples: pd.DataFrame
+    name: str,
+    options: CampaignOptions,
+    stored: dict | None,
+    samples: pd.DataFrame,
+    added: frozenset[str] = frozenset(),
 ) -> tuple[Plan, SampleBank]:
     """The plan and sample bank of campaign ``name`` with ``options`` (merged with the
     ``stored`` definition; ``options.prep`` the label of ``samples``, see
-    `campaign_samples`); refuses a definition that differs from the stored one or data that
-    cannot supply it."""
+    `campaign_samples`; ``added`` as in `make_plan`); refuses a definition that differs
+    from the stored one or data that cannot supply it."""
     plan, bank = make_plan(
-        name, options, rounded_conditions(samples), lambda c: SampleBank.build(samples, c)
+        name,
+        options,
+        rounded_conditions(samples),
+        lambda c: SampleBank.build(samples, c),
+        added,
     )
     if stored is not None:
         check_same(
@@ -358,6 +373,8 @@ def plan_campaign(
     # With skip_infeasible the plan already left out every cell the data cannot
     # supply; conditions without any complete cycle are refused either way.
     needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
+    # the added conditions' infeasible cells are already left out (`make_plan`)
+    needs = {c: n for c, n in needs.items() if c[0] not in added}
     check_feasible(bank, plan.train_conditions, plan.test_conditions, needs)
     return plan, bank
 

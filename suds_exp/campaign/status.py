@@ -9,6 +9,7 @@ import pandas as pd
 
 from suds_exp.campaign.lock import run_holder
 from suds_exp.errors import CampaignError
+from suds_exp.ingest import stored_design
 from suds_exp.store import Store
 
 
@@ -82,7 +83,8 @@ def campaign_status(store: Store, name: str) -> dict:
     during the last run, None before any), ``eta_s`` (seconds left at that rate while
     running, else None), ``skipped_cells`` (the (condition, training cycles) cells the
     campaign leaves out, asked for with ``skip_infeasible``: list of {condition,
-    n_cycles, pairs}).
+    n_cycles, pairs}), ``experiment`` (the design stored with the data,
+    `suds_exp.ingest.stored_design`: {source, axes: list of {name, kind, levels, added}}).
     """
     with store.read() as conn:
         definition, total, prep, per_model, started, since = _read_status(
@@ -111,4 +113,17 @@ def campaign_status(store: Store, name: str) -> dict:
         "rate_jobs_per_s": rate,
         "eta_s": eta,
         "skipped_cells": definition.get("skipped_cells", []),
+        "experiment": design_document(stored_design(store)),
+    }
+
+
+def design_document(design) -> dict:
+    """An `ExperimentDesign` as JSON-ready data: ``source`` and ``axes`` (each ``name``,
+    ``kind``, declared ``levels`` and ``added`` levels)."""
+    return {
+        "source": design.source,
+        "axes": [
+            {"name": a.name, "kind": a.kind, "levels": list(a.levels), "added": list(a.added)}
+            for a in design.axes
+        ],
     }

@@ -95,11 +95,23 @@ def print_status(status: dict) -> None:
     elif rate:
         line += f" - not running (last run: {rate:.2f} jobs/s)"
     console.out.print(line)
+    if status.get("experiment"):
+        console.out.print(design_line(status["experiment"]))
     if status.get("skipped_cells"):
         console.out.print(
             "left out (--skip-infeasible; the data cannot supply them): "
             + skipped_cells_text(status)
         )
+
+
+def design_line(experiment: dict) -> str:
+    """``experiment paper.toml: axes gait (unordered; 1 level added), frequency_hz
+    (numeric)`` from `suds_exp.campaign.status.design_document`."""
+    axes = []
+    for a in experiment["axes"]:
+        added = f"; {len(a['added'])} level(s) added" if a["added"] else ""
+        axes.append(f"{a['name']} ({a['kind']}{added})")
+    return f"experiment {experiment['source']}: axes {', '.join(axes) or 'none'}"
 
 
 def _duration(seconds: float | None) -> str:

@@ -13,6 +13,7 @@ from suds_exp.analysis.findings import (
     findings_headline,
     findings_json,
     passive_display,
+    passive_reason,
 )
 
 
@@ -32,15 +33,20 @@ def show_findings(store, name: str, n_boot: int = 400, seed: int = 0, as_json=Fa
 
 
 def print_findings(table: pd.DataFrame, campaign: str) -> None:
-    """Print the findings table and its headline on the terminal."""
+    """Print the findings table and its headline on the terminal; on a design other than
+    the paper's (`for_design`), first its caveat and then what was left out."""
+    if "caveat" in table.attrs:
+        console.out.print(table.attrs["caveat"] + ".")
     console.print_frame(findings_display(table), title=f"the paper's findings on {campaign}")
     console.out.print(findings_headline(table))
+    if table.attrs.get("left_out"):
+        console.out.print("not measurable on this design: " + "; ".join(table.attrs["left_out"]))
 
 
 def print_passive_information(table: pd.DataFrame) -> None:
     """Print the passive-information table and its explanation on the terminal."""
     if table.empty:
-        console.out.print("what the passive shape adds: not measurable (no stored samples)")
+        console.out.print(f"what the passive shape adds: not measurable ({passive_reason(table)})")
         return
     console.print_frame(passive_display(table), title="what the passive shape adds")
     console.out.print(PASSIVE_EXPLANATION)

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from importlib.resources import files
 from pathlib import Path
@@ -49,12 +49,22 @@ _FORBIDDEN = (";", "=", "@", ",")
 
 @dataclass(frozen=True)
 class Axis:
-    """One condition axis: ``name`` (a manifest column), ``kind`` (one of `KINDS`) and
-    ``levels`` (the ordered or unordered categories; empty for numeric)."""
+    """One condition axis: ``name`` (a manifest column), ``kind`` (one of `KINDS`),
+    ``levels`` (the declared ordered or unordered categories; empty for numeric) and
+    ``added`` (levels that code adding trials gave it after the declaration, e.g. the
+    gaits `gait design --verify` ran; `suds_exp.ingest.add_trial_levels`). An added level
+    of an ordered axis has no place in the declared order: a pair with it is ``same`` or
+    ``far``, never ``near``."""
 
     name: str
     kind: str
     levels: tuple[str, ...] = ()
+    added: tuple[str, ...] = ()
+
+    @property
+    def all_levels(self) -> tuple[str, ...]:
+        """The declared levels, then the added ones."""
+        return self.levels + self.added
 
     @property
     def categories(self) -> tuple[str, ...]:
@@ -74,7 +84,7 @@ class Axis:
                 expected = "a positive number of Hz" if self.name == FREQUENCY_AXIS else "a number"
                 raise ConfigError(f"{where}: {self.name} {text!r}: expected {expected}")
             return round(value, 6)
-        if text not in self.levels:
+        if text not in self.all_levels:
             raise ConfigError(
                 f"{where}: {self.name} {text!r} is not a declared level; expected one of "
                 f"{', '.join(self.levels)}"
@@ -93,6 +103,16 @@ class ExperimentDesign:
     def names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.axes)
 
+    def with_added(self, added: dict[str, tuple[str, ...]]) -> ExperimentDesign:
+        """This design with ``added`` (axis name -> levels added by code that adds
+        trials) appended to its ordered and unordered axes of those names; levels it
+        declares or already holds are not repeated."""
+        axes = []
+        for a in self.axes:
+            extra = tuple(v for v in added.get(a.name, ()) if v not in a.all_levels)
+            axes.append(replace(a, added=a.added + extra) if extra and a.levels else a)
+        return ExperimentDesign(tuple(axes), self.source)
+
     def axis(self, name: str) -> Axis:
         for a in self.axes:
             if a.name == name:
@@ -108,6 +128,13 @@ class ExperimentDesign:
     def label_axes(self) -> tuple[Axis, ...]:
         """The axes that make up a condition label (all but the frequency)."""
         return tuple(a for a in self.axes if a.name != FREQUENCY_AXIS)
+
+    @property
+    def added_labels(self) -> frozenset[str]:
+        """Labels of the conditions whose level code added after the declaration (its one
+        condition axis's `Axis.added`; none with several condition axes)."""
+        axes = self.label_axes
+        return frozenset(axes[0].added) if len(axes) == 1 else frozenset()
 
     def label(self, values: dict[str, str | float]) -> str:
         """A condition's label from its axis values: the value of the one label axis
@@ -138,6 +165,15 @@ class ExperimentDesign:
         if FREQUENCY_AXIS in self.names:
             out[FREQUENCY_AXIS] = round(float(frequency_hz), 6)
         return out
+
+
+def level_problem(level: str) -> str | None:
+    """Why ``level`` cannot be a level's name (empty, padded, or holding a character a
+    condition label or option string uses), or None when it can."""
+    if not isinstance(level, str) or not level or level.strip() != level:
+        return "expected a name without leading or trailing spaces"
+    bad = [c for c in _FORBIDDEN if c in level]
+    return f"contains one of {' '.join(_FORBIDDEN)}" if bad else None
 
 
 def _text(value) -> str:

@@ -27,6 +27,11 @@ def classify(axis: Axis, train, test) -> str:
         a, b = round(float(train), 6), round(float(test), 6)
         return "same" if a == b else ("lower" if a < b else "higher")
     if axis.kind == "ordered":
+        if train == test:
+            return "same"
+        if train in axis.added or test in axis.added:
+            # an added level has no place in the declared order (see `Axis`)
+            return "far"
         steps = abs(axis.levels.index(train) - axis.levels.index(test))
         return "same" if steps == 0 else ("near" if steps == 1 else "far")
     return "same" if train == test else "different"

@@ -18,7 +18,9 @@ the version's body (1 to 8; order ``order``) subject to
 With ``verify`` each designed gait is run on the simulator as a new trial (10 cycles at
 the design frequency through the actuator, like any capture), ingested and preprocessed
 into the same version, so the next iteration's map has seen it: the support grows where
-the designer is going. Its achieved motion is measured on the simulator by
+the designer is going. Its gait becomes an added level of the stored experiment design
+(`suds_exp.ingest.add_trial_levels`), so campaigns and reports take it as a condition.
+Its achieved motion is measured on the simulator by
 `suds_exp.gait.truth` (the same measurement as the ceiling benchmark). Without
 ``verify`` the data never change and each iteration only widens the trust radius.
 
@@ -55,6 +57,7 @@ from suds_exp.gait.shape import SWIMMER_JOINTS, FourierGait, check_bound, within
 from suds_exp.gait.support import Support
 from suds_exp.gait.trials import simulate_gait_file
 from suds_exp.gait.truth import simulate_gaits
+from suds_exp.ingest import add_trial_levels, stored_design, trial_level_axis
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
 from suds_exp.preprocess import get_version
@@ -298,6 +301,9 @@ def design_gait(
         raise ConfigError(
             f"version {version.name} has no samples; preprocess trials first", step="preprocess"
         )
+    if opts.verify:
+        # refused before anything is stored: where the verify trials would go
+        trial_level_axis(stored_design(store))
     design_id = _register(store, version.id, opts)
     design = Design(design_id, version.id, opts, joints=joints)
     out = Path(out)
@@ -418,6 +424,9 @@ def _verify_trial(store, version, gait, opts, out, design_id, it, config) -> int
         folder, gait, config, (opts.frequency_hz,), 1, (opts.cycles, opts.cycles), seed, store
     )
     trial_id = int(summary["trial_ids"][0])
+    # the designed gait becomes a level of the stored design, so that every command
+    # treats its trial as one of the experiment's conditions
+    add_trial_levels(store, {trial_id: gait.name}, added_by=f"gait design {design_id}")
     run_preprocess(store, version.name, params=version.params, trials=[trial_id], progress=False)
     return trial_id
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import sqlalchemy as sa
 
 from suds_exp.errors import IngestError
-from suds_exp.experiment import ExperimentDesign
+from suds_exp.experiment import ExperimentDesign, is_paper
 from suds_exp.ingest.layout import check_layout, layout_json, read_layout
 from suds_exp.ingest.manifest import Condition, check_axes, read_manifest, store_condition
 from suds_exp.ingest.pose import PoseOptions
@@ -114,7 +114,7 @@ def ingest_file(
             .returning(trials.c.id)
         ).scalar_one()
         store.insert_df(conn, markers.name, capture.long_frame(trial_id))
-        if condition is not None and condition.axes and design is not None:
+        if condition is not None and design is not None and not is_paper(design):
             store_condition(conn, trial_id, condition, design)
     label = (
         f"{condition.gait} {condition.frequency_hz:g} Hz #{condition.repeat}"

@@ -14,12 +14,12 @@ values go to `trial_conditions` (migration 020).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
 from suds_exp.errors import ConfigError, IngestError
 from suds_exp.experiment import FREQUENCY_AXIS, Axis, ExperimentDesign, is_paper
+from suds_exp.ingest.experiment import levels_json, store_description, store_values
 from suds_exp.ingest.tables_csv import read_text_table
 from suds_exp.robot import GAITS, parse_frequency
 
@@ -57,7 +57,9 @@ def read_manifest(path: Path, design: ExperimentDesign | None = None) -> dict[Pa
         if gait not in GAITS and not gait.lower().endswith(GAIT_FILE_SUFFIXES):
             raise IngestError(
                 f"{where}: unknown gait {gait!r}; expected one of {', '.join(GAITS)} "
-                "or a gait file's name (.csv, .toml)"
+                "or a gait file's name (.csv, .toml); declare your own gaits in a TOML "
+                "description given as experiment (docs/how-to/own-experiment.md)",
+                param="experiment",
             )
         try:
             freq = parse_frequency(row.frequency_hz)
@@ -124,7 +126,7 @@ def check_axes(conn, design: ExperimentDesign) -> None:
         for r in conn.exec_driver_sql("SELECT axis, kind, levels FROM experiment_axes")
     }
     for a in design.axes:
-        if a.name in stored and stored[a.name] != (a.kind, _levels_json(a)):
+        if a.name in stored and stored[a.name] != (a.kind, levels_json(a)):
             kind, levels = stored[a.name]
             raise IngestError(
                 f"{design.source}: axis {a.name!r} is declared {a.kind} {list(a.levels)} but "
@@ -134,29 +136,7 @@ def check_axes(conn, design: ExperimentDesign) -> None:
 
 
 def store_condition(conn, trial_id: int, condition: Condition, design: ExperimentDesign) -> None:
-    """Write the design's axes (those not stored yet) and the trial's values along them,
-    in the caller's transaction."""
-    if not condition.axes:
-        return
-    have = {r[0] for r in conn.exec_driver_sql("SELECT axis FROM experiment_axes")}
-    for a in design.axes:
-        if a.name in have:
-            continue
-        conn.exec_driver_sql(
-            "INSERT INTO experiment_axes SELECT ?, count(*), ?, ? FROM experiment_axes",
-            (a.name, a.kind, _levels_json(a)),
-        )
-        for i, level in enumerate(a.levels):
-            conn.exec_driver_sql(
-                "INSERT INTO experiment_levels VALUES (?, ?, ?)", (a.name, level, i)
-            )
-    for name, value in condition.axes:
-        number = float(value) if isinstance(value, float) else None
-        text = f"{value:g}" if number is not None else str(value)
-        conn.exec_driver_sql(
-            "INSERT INTO trial_conditions VALUES (?, ?, ?, ?)", (trial_id, name, text, number)
-        )
-
-
-def _levels_json(axis: Axis) -> str | None:
-    return json.dumps(list(axis.levels)) if axis.levels else None
+    """Store the design as the database's description (`store_description`: the axes not
+    stored yet) and the trial's values along its axes, in the caller's transaction."""
+    store_description(conn, design)
+    store_values(conn, trial_id, condition.axes)
