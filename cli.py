@@ -8,14 +8,16 @@ from __future__ import annotations
 
 import functools
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from suds_exp import __version__, console
 from suds_exp.commands.messages import user_message
 from suds_exp.errors import SudsError
-from suds_exp.store import Store, default_db_path
+
+if TYPE_CHECKING:
+    from suds_exp.store import Store
 
 app = typer.Typer(
     name="suds-exp",
@@ -94,6 +96,9 @@ def main(
 
 
 def open_store(db: Path | None) -> Store:
+    # imported here: `--version` and `--help` need neither SQLAlchemy nor pandas
+    from suds_exp.store import Store, default_db_path
+
     return Store(db if db is not None else default_db_path())
 
 

@@ -1,18 +1,22 @@
-"""Terminal output shared by the CLI commands: tables, JSON, messages."""
+"""Terminal output shared by the CLI commands: tables, JSON, messages.
+
+pandas and the store's JSON writer are imported where a table is printed: `suds-exp
+--version` and `--help` print none and start without them.
+"""
 
 from __future__ import annotations
 
 import json
 import sys
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import pandas as pd
 from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from suds_exp.store.sql import frame_to_json
+if TYPE_CHECKING:
+    import pandas as pd
 
 out = Console(highlight=False, soft_wrap=True)
 err = Console(stderr=True, highlight=False, soft_wrap=True)
@@ -20,6 +24,8 @@ err = Console(stderr=True, highlight=False, soft_wrap=True)
 
 def print_frame(frame: pd.DataFrame, title: str | None = None, max_rows: int = 200) -> None:
     """Print a DataFrame as a rich table (first ``max_rows`` rows)."""
+    import pandas as pd
+
     table = Table(title=title, show_lines=False)
     # cells are data: Text, so a label such as "learner[kNN]" is not read as rich markup
     for column in frame.columns:
@@ -48,6 +54,10 @@ def output_lines(enabled: bool = True) -> Callable[[str], None]:
 
 def print_json(document: Any) -> None:
     """Print one JSON document on stdout (a DataFrame becomes a list of row objects)."""
+    import pandas as pd
+
+    from suds_exp.store.sql import frame_to_json
+
     if isinstance(document, pd.DataFrame):
         text = frame_to_json(document)
     else:

@@ -5,14 +5,52 @@ fills `results`; `campaign_status(store, name)` reports its progress (the small 
 `suds-exp demo` is `suds_exp.testing.demo_campaign`).
 """
 
-from suds_exp.campaign.bank import SampleBank
-from suds_exp.campaign.conditions import PAPER_SWEEP, parse_int_list
-from suds_exp.campaign.definition import CampaignOptions
-from suds_exp.campaign.grid import KEY_COLUMNS, Draw, enumerate_draws
-from suds_exp.campaign.job import RESULT_COLUMNS, TIMING_COLUMNS
-from suds_exp.campaign.runner import RunSummary, run_campaign
-from suds_exp.campaign.status import campaign_status
-from suds_exp.errors import CampaignError
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # what the names are, for readers and static tools; loaded on first use
+    from suds_exp.campaign.bank import SampleBank
+    from suds_exp.campaign.conditions import PAPER_SWEEP, parse_int_list
+    from suds_exp.campaign.definition import CampaignOptions
+    from suds_exp.campaign.grid import KEY_COLUMNS, Draw, enumerate_draws
+    from suds_exp.campaign.job import RESULT_COLUMNS, TIMING_COLUMNS
+    from suds_exp.campaign.runner import RunSummary, run_campaign
+    from suds_exp.campaign.status import campaign_status
+    from suds_exp.errors import CampaignError
+
+#: Where each public name lives. Loaded on first use (PEP 562), so `suds-exp status`
+#: imports the status module, not the learners and scikit-learn behind a definition.
+_HOMES = {
+    "SampleBank": "suds_exp.campaign.bank",
+    "PAPER_SWEEP": "suds_exp.campaign.conditions",
+    "parse_int_list": "suds_exp.campaign.conditions",
+    "CampaignOptions": "suds_exp.campaign.definition",
+    "KEY_COLUMNS": "suds_exp.campaign.grid",
+    "Draw": "suds_exp.campaign.grid",
+    "enumerate_draws": "suds_exp.campaign.grid",
+    "RESULT_COLUMNS": "suds_exp.campaign.job",
+    "TIMING_COLUMNS": "suds_exp.campaign.job",
+    "RunSummary": "suds_exp.campaign.runner",
+    "run_campaign": "suds_exp.campaign.runner",
+    "campaign_status": "suds_exp.campaign.status",
+    "CampaignError": "suds_exp.errors",
+}
+
+
+def __getattr__(name: str):
+    home = _HOMES.get(name)
+    if home is None:
+        raise AttributeError(f"module 'suds_exp.campaign' has no attribute {name!r}")
+    value = getattr(importlib.import_module(home), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
 
 __all__ = [
     "KEY_COLUMNS",

@@ -9,19 +9,19 @@ from __future__ import annotations
 import ast
 import json
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from suds_exp import console
 from suds_exp.campaign.conditions import parse_int_list
-from suds_exp.campaign.definition import (
-    DEFAULTS,
-    CampaignOptions,
-    resolve_models,
-    skipped_cells_text,
-)
 from suds_exp.errors import CampaignError
-from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
+
+if TYPE_CHECKING:
+    from suds_exp.campaign.definition import CampaignOptions
+
+# The definition and the learner registry import every learner (scikit-learn and more):
+# imported where options are parsed, so `suds-exp status` starts without them.
 
 
 def parse_campaign_options(
@@ -35,6 +35,9 @@ def parse_campaign_options(
     `SURVEY_LEARNERS`), ``sweep="1-10,21"`` (or ``"paper"``), ``model_params`` as
     ``["MLP.alpha=0.01", ...]`` (see `parse_model_params`); the rest as in
     `CampaignOptions`."""
+    from suds_exp.campaign.definition import DEFAULTS, CampaignOptions, resolve_models
+    from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
+
     names = None if models is None else [m.strip() for m in models.split(",") if m.strip()]
     if names is not None:
         names = [n for m in names for n in (SURVEY_LEARNERS if m == "survey" else (m,))]
@@ -98,6 +101,8 @@ def print_status(status: dict) -> None:
     if status.get("experiment"):
         console.out.print(design_line(status["experiment"]))
     if status.get("skipped_cells"):
+        from suds_exp.campaign.definition import skipped_cells_text
+
         console.out.print(
             "left out (--skip-infeasible; the data cannot supply them): "
             + skipped_cells_text(status)
