@@ -35,6 +35,19 @@ DbOption = Annotated[
     ),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
+
+
+def old_name(flag: str, new: str):
+    """A hidden option: ``flag``, the name ``new`` had before the commands shared one
+    vocabulary (kept for one release; the changelog lists them)."""
+    return typer.Option(flag, hidden=True, help=f"Old name of {new}.")
+
+
+def either(value, old):
+    """The value given under the old name when there was one, else the new name's."""
+    return value if old is None else old
+
+
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
 
 
@@ -440,7 +453,7 @@ def run(
         raise typer.Exit(130)
 
 
-@command()
+@command(flags={"n_boot": "--boots"})
 def survey(
     name: Annotated[
         str, typer.Argument(help="Campaign with a --sweep and/or a main grid of cross pairs.")
@@ -449,7 +462,8 @@ def survey(
     versus: Annotated[
         str, typer.Option(help="Learner whose data need is set against GMR's.")
     ] = "MLP",
-    n_boot: Annotated[int, typer.Option(help="Bootstrap resamples of the ratio.")] = 1000,
+    boots: Annotated[int, typer.Option(help="Bootstrap resamples of the ratio.")] = 1000,
+    n_boot: Annotated[int | None, old_name("--n-boot", "--boots")] = None,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -462,7 +476,7 @@ def survey(
     from suds_exp.analysis.survey import survey_json, survey_tables
     from suds_exp.commands.survey import print_survey
 
-    tables = survey_tables(open_store(db), name, cycles, n_boot, versus)
+    tables = survey_tables(open_store(db), name, cycles, either(boots, n_boot), versus)
     if json_:
         console.print_json(survey_json(tables))
     else:
@@ -524,10 +538,11 @@ def report(
         console.out.print(f"wrote {index}")
 
 
-@command(flags={"n_boot": "--boot"})
+@command(flags={"n_boot": "--boots"})
 def findings(
     name: Annotated[str, typer.Argument(help="Campaign name.")],
-    boot: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
+    boots: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
+    boot: Annotated[int | None, old_name("--boot", "--boots")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -539,7 +554,7 @@ def findings(
     """
     from suds_exp.commands.findings import show_findings
 
-    show_findings(open_store(db), name, n_boot=boot, seed=seed, as_json=json_)
+    show_findings(open_store(db), name, n_boot=either(boots, boot), seed=seed, as_json=json_)
 
 
 @command(flags={"exclude": "--exclude-candidates", "model_effects": "--model-effect"})
@@ -696,7 +711,7 @@ PrepOption = Annotated[
 LearnerOption = Annotated[str, typer.Option(help="Learner name (see suds_exp.models).")]
 
 
-@command(on=gait_app, name="predict", flags={"frequency_hz": "--freq", "n_boot": "--boot"})
+@command(on=gait_app, name="predict", flags={"frequency_hz": "--freq", "n_boot": "--boots"})
 def gait_predict(
     gait_file: Annotated[
         Path,
@@ -708,9 +723,10 @@ def gait_predict(
     trials_: Annotated[
         str | None, typer.Option("--trials", help="Training trial ids (default: all).")
     ] = None,
-    boot: Annotated[
+    boots: Annotated[
         int, typer.Option(help="Bootstrap refits for the 95 % intervals: 0 (none) or 40+.")
     ] = 40,
+    boot: Annotated[int | None, old_name("--boot", "--boots")] = None,
     bound: Annotated[float, typer.Option(help="Joint bound the gait must keep, rad.")] = 2.0,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -727,7 +743,14 @@ def gait_predict(
 
     (frequency,) = parse_freqs(freq)[:1]
     doc = predict_command(
-        open_store(db), gait_file, frequency, prep, learner, parse_ids(trials_), boot, bound
+        open_store(db),
+        gait_file,
+        frequency,
+        prep,
+        learner,
+        parse_ids(trials_),
+        either(boots, boot),
+        bound,
     )
     if json_:
         console.print_json(doc)

@@ -138,7 +138,7 @@ def test_the_bootstrap_is_reproducible_from_its_seed(store):
 def test_cli_findings_json_and_bad_input(store):
     runner = CliRunner()
     out = runner.invoke(
-        app, ["findings", "exact", "--db", str(store.path), "--boot", "10", "--json"]
+        app, ["findings", "exact", "--db", str(store.path), "--boots", "10", "--json"]
     )
     assert out.exit_code == 0, out.output
     doc = json.loads(out.stdout)
@@ -148,9 +148,9 @@ def test_cli_findings_json_and_bad_input(store):
     assert doc["headline"].startswith("8 of 10 findings hold (8 holds, 2 fails)")
     f1 = doc["statistics"][0]
     assert f1["verdict"] == "holds" and f1["holds"] is True and f1["low"] <= f1["value"]
-    out = runner.invoke(app, ["findings", "nosweep", "--db", str(store.path), "--boot", "5"])
+    out = runner.invoke(app, ["findings", "nosweep", "--db", str(store.path), "--boots", "5"])
     assert out.exit_code == 0 and "not measurable" in out.stdout and "F10" in out.stdout
-    out = runner.invoke(app, ["findings", "exact", "--db", str(store.path), "--boot", "-1"])
-    assert out.exit_code == 2 and "--boot" in out.output and len(out.output.splitlines()) == 1
+    out = runner.invoke(app, ["findings", "exact", "--db", str(store.path), "--boots", "-1"])
+    assert out.exit_code == 2 and "--boots" in out.output and len(out.output.splitlines()) == 1
     out = runner.invoke(app, ["findings", "nope", "--db", str(store.path)])
     assert out.exit_code == 2 and "'nope'" in out.output

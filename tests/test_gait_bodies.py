@@ -131,13 +131,13 @@ def test_the_silent_phi2_is_refused_naming_the_column_and_the_body_s_joints(body
     # issue 39: on a body with one actuated joint the gait's phi2 was ignored (the same
     # prediction whether phi2 was an ellipse or zero)
     gait = wave_toml(tmp_path / "two.toml", ["phi1"], extra={"phi2": 1.0})
-    line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boot", "0")
+    line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boots", "0")
     assert "two.toml" in line and "'phi2'" in line and "phi1" in line, line
     assert "no joint" in line, line
     # the gait of the joint the body has is predicted
     one = wave_toml(tmp_path / "one.toml", ["phi1"])
     doc = json.loads(
-        ok("gait", "predict", "--gait-file", one, "--boot", "0", "--db", body_db, "--json")
+        ok("gait", "predict", "--gait-file", one, "--boots", "0", "--db", body_db, "--json")
     )
     assert doc["joints"] == ["phi1"] and math.isfinite(doc["forward_mm"])
 
@@ -145,7 +145,7 @@ def test_the_silent_phi2_is_refused_naming_the_column_and_the_body_s_joints(body
 @pytest.mark.parametrize("body_db", [4], indirect=True)
 def test_a_gait_missing_one_of_the_body_s_joints_is_refused(body_db, tmp_path):
     gait = wave_toml(tmp_path / "three.toml", ["q1", "q2", "q3"])
-    line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boot", "0")
+    line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boots", "0")
     assert "three.toml" in line and "'q4'" in line, line
 
 
@@ -157,7 +157,7 @@ def test_predict_flags_a_gait_outside_the_data_s_support(body_db, tmp_path, requ
     docs = {}
     for g in (inside, outside):
         docs[g.stem] = json.loads(
-            ok("gait", "predict", "--gait-file", g, "--boot", "0", "--db", body_db, "--json")
+            ok("gait", "predict", "--gait-file", g, "--boots", "0", "--db", body_db, "--json")
         )
         assert docs[g.stem]["joints"] == joints
         for key in ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s"):
@@ -165,9 +165,9 @@ def test_predict_flags_a_gait_outside_the_data_s_support(body_db, tmp_path, requ
     assert docs["inside"]["support"]["inside"] is True, docs["inside"]["support"]
     assert docs["outside"]["support"]["inside"] is False, docs["outside"]["support"]
     assert docs["outside"]["support"]["distance_rad"] > docs["outside"]["support"]["radius_rad"]
-    text = ok("gait", "predict", "--gait-file", outside, "--boot", "0", "--db", body_db)
+    text = ok("gait", "predict", "--gait-file", outside, "--boots", "0", "--db", body_db)
     assert "outside the data's support" in text, text
-    text = ok("gait", "predict", "--gait-file", inside, "--boot", "0", "--db", body_db)
+    text = ok("gait", "predict", "--gait-file", inside, "--boots", "0", "--db", body_db)
     assert "outside" not in text, text
 
 
@@ -176,8 +176,8 @@ def test_the_estimate_outside_its_interval_is_refused_or_explained(body_db, tmp_
     # issue 39: `--boot 3` gave lateral_mm 12.97 against its interval [10.106, 12.703]:
     # 3 refits cannot estimate 2.5 and 97.5 percentiles
     gait = wave_toml(tmp_path / "w.toml", ["q1", "q2"])
-    line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boot", "3")
-    assert "--boot 3" in line and str(MIN_BOOT) in line, line
+    line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boots", "3")
+    assert "--boots 3" in line and str(MIN_BOOT) in line, line
 
 
 def test_an_interval_that_misses_its_estimate_says_why():
@@ -246,7 +246,7 @@ def test_every_estimate_lies_inside_its_interval_or_says_why(body_db, tmp_path):
     # allowed: each interval holds its estimate, or the JSON and the text say why not
     gait = tmp_path / "circle.toml"
     gait.write_text("[q1]\ncos = [1.0]\n\n[q2]\nsin = [1.0]\n")
-    args = ("gait", "predict", "--gait-file", gait, "--boot", str(MIN_BOOT), "--db", body_db)
+    args = ("gait", "predict", "--gait-file", gait, "--boots", str(MIN_BOOT), "--db", body_db)
     doc = json.loads(ok(*args, "--json"))
     assert doc["n_boot"] == MIN_BOOT
     for key in ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s"):
