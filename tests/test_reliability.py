@@ -65,7 +65,7 @@ def test_refused_options_leave_the_database_byte_identical_and_names_free(data, 
         (["stream", "s", "--change-at", "-5"], "--change-at '-5': expected a time > 0"),
         (["stream", "s", "--change-at", "abc"], "--change-at 'abc': expected a time"),
         (["stream", "s", "--plot", str(blocker / "x.png")], "--plot: folder"),
-        (["findings", "c", "--boot", "0"], "--boot 0"),
+        (["findings", "c", "--boots", "0"], "--boots 0"),
         (["discrepancy", "--out", str(blocker / "d")], "--out: report folder"),
         (["report", "c", "--out", str(blocker / "r")], "--out: report folder"),
     ]
