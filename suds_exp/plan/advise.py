@@ -55,18 +55,22 @@ def plan_next(
     n_boot: int = N_BOOT,
     trust: float = TRUST0,
     seed: int = 0,
+    max_evals: int = 150,
 ) -> Advice:
     """Recommend the next ``n`` trials of ``cycles`` cycles for ``goal`` ("map": reduce
     the target's prediction uncertainty; "gait": improve the best forward displacement per
     cycle within ``target.bound``) on version ``prep``. A gait goal's new Fourier gait is
     written to ``out``/NAME.toml; ``trust`` (rad) bounds its distance from the recorded
-    data. Seeds derive from (``seed``, the version, the goal)."""
+    data; ``max_evals``: map evaluations per start of the gait search. Seeds derive from
+    (``seed``, the version, the goal)."""
     if goal not in GOALS:
         raise ConfigError(f"goal {goal!r}: expected one of {', '.join(GOALS)}", param="goal")
     if n < 1:
         raise ConfigError(f"n {n}: must be >= 1 trial", param="n")
     if cycles < 1:
         raise ConfigError(f"cycles {cycles}: must be >= 1 per trial", param="cycles")
+    if n_boot < 2:
+        raise ConfigError(f"n_boot {n_boot}: need >= 2 refits for a spread", param="n_boot")
     make_model(learner)
     target = target or Target()
     version = get_version(store, prep)
@@ -85,8 +89,13 @@ def plan_next(
         out = Path(out)
         name = f"plan-v{version.id}-{key % 10**6:06d}.toml"
         rec, _, _ = recommend_gait(
-            ensemble, Support.of(samples), _recorded_gaits(samples, out), target, trust,
-            cycles, name,
+            ensemble,
+            Support.of(samples),
+            _recorded_gaits(samples, out),
+            target,
+            trust,
+            cycles,
+            name,
         )
         out.mkdir(parents=True, exist_ok=True)
         path = out / name

@@ -1,7 +1,7 @@
 """When more data of this kind stops helping: the learning curve and its stopping signal.
 
-The held-out error of the learner is measured at nested training sizes that double
-(``cycles / 4``, ``cycles / 2``, all the training cycles): the version's cycle blocks
+The held-out error of the learner is measured at two nested training sizes, one double
+the other (half the training cycles, all of them): the version's cycle blocks
 (one cycle of one trial each) are split into `N_FOLDS` folds by a seeded shuffle, each
 fold predicted by maps fitted on growing prefixes of the other folds' blocks. The error
 is the RMS of the forward body velocity v_x (mm/s) on the held-out blocks, averaged over
@@ -74,7 +74,8 @@ def learning_curve(samples: pd.DataFrame, learner: str = GMR, seed: int = 0) -> 
     order = np.random.default_rng([seed, 7]).permutation(len(blocks))
     folds = np.array_split(order, N_FOLDS)
     n_train = len(blocks) - max(len(f) for f in folds)
-    sizes = sorted({max(1, n_train // 4), max(1, n_train // 2), n_train})
+    # two sizes are what the signal reads (the last doubling); each costs N_FOLDS fits
+    sizes = sorted({max(1, n_train // 2), n_train})
     errors = np.full((N_FOLDS, len(sizes)), np.nan)
     for i, held in enumerate(folds):
         rest = [j for j in order if j not in set(held)]

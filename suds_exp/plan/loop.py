@@ -43,8 +43,8 @@ from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
 from suds_exp.plan.curve import learning_curve
 from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
-from suds_exp.plan.record import add_trial_to_version, record_trial
 from suds_exp.plan.recommend import Recommendation, Trial, recommend_gait, recommend_map
+from suds_exp.plan.record import add_trial_to_version, record_trial
 from suds_exp.plan.target import GOALS, Target, TargetTruth
 from suds_exp.preprocess import get_version
 from suds_exp.preprocess import preprocess as run_preprocess
@@ -84,7 +84,9 @@ class LoopOptions:
     def check(self) -> Target:
         """Refuse a bad recipe in one line before anything is read or stored; the target."""
         if self.goal not in GOALS:
-            raise ConfigError(f"goal {self.goal!r}: expected one of {', '.join(GOALS)}", param="goal")
+            raise ConfigError(
+                f"goal {self.goal!r}: expected one of {', '.join(GOALS)}", param="goal"
+            )
         if self.budget_cycles <= 0:
             raise ConfigError(
                 f"budget_cycles {self.budget_cycles}: must be > 0 recorded cycles",
@@ -98,7 +100,9 @@ class LoopOptions:
                 param="warmup_gait",
             )
         if self.n_boot < 2:
-            raise ConfigError(f"n_boot {self.n_boot}: need >= 2 refits for a spread", param="n_boot")
+            raise ConfigError(
+                f"n_boot {self.n_boot}: need >= 2 refits for a spread", param="n_boot"
+            )
         make_model(self.learner)  # an unknown learner is refused here
         return Target.of(self.target_files, self.target_frequencies_hz, self.bound)
 
@@ -212,6 +216,19 @@ class _State:
         self.cycles_total = version_cycles(self.samples)
 
 
+class _LazyTruth:
+    """`TargetTruth`, simulated when an iteration first needs it (a finished loop that is
+    run again needs none)."""
+
+    def __init__(self, target: Target):
+        self.target, self._truth = target, None
+
+    def map_error(self, fitted) -> float:
+        if self._truth is None:
+            self._truth = TargetTruth(self.target)
+        return self._truth.map_error(fitted)
+
+
 def version_cycles(samples: pd.DataFrame) -> int:
     """Cycles in a samples frame: each trial's duration x frequency, rounded, summed."""
     total = 0.0
@@ -294,7 +311,7 @@ def run_loop(
 
 
 def _run(store, opts, target, version, name, folder, config, progress, on_iteration) -> Loop:
-    truth = TargetTruth(target)
+    truth = _LazyTruth(target)
     achieved: dict[str, float] = {}
     loop_id, rows = _find_loop(store, name)
     if loop_id is None:
@@ -311,7 +328,9 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
         state = _State(store, version, opts, target, truth, folder, name, 0, achieved)
         if warm is not None:
             trial, recorded = warm.to_dict(), warm.cycles
-            reason = f"warm-up: {warm.cycles} cycles of {warm.gait.name} at {warm.frequency_hz:g} Hz"
+            reason = (
+                f"warm-up: {warm.cycles} cycles of {warm.gait.name} at {warm.frequency_hz:g} Hz"
+            )
         else:
             trial = {"gait": "existing version", "frequency_hz": 0.0, "cycles": 0}
             recorded, trial_id = 0, None
@@ -325,7 +344,10 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
     loop = Loop(loop_id, name, version.id, opts, list(rows))
     recorded = loop.iterations[-1].cycles_recorded
     with progress_bar(
-        "Plan loop", opts.budget_cycles, enabled=progress, done=min(recorded, opts.budget_cycles),
+        "Plan loop",
+        opts.budget_cycles,
+        enabled=progress,
+        done=min(recorded, opts.budget_cycles),
         unit="cycles",
     ) as advance:
         while recorded + opts.cycles <= opts.budget_cycles:
@@ -345,8 +367,15 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
                 trust = _next_trust(trust, rec, state, target, before)
             recorded += rec.trial.cycles
             row = _iteration(
-                it, rec.trial.to_dict(), rec.reason, rec.score, recorded, state, trust,
-                trial_id, started,
+                it,
+                rec.trial.to_dict(),
+                rec.reason,
+                rec.score,
+                recorded,
+                state,
+                trust,
+                trial_id,
+                started,
             )
             _store_iteration(store, loop_id, row)
             loop.iterations.append(row)
@@ -370,11 +399,19 @@ def _plan(state: _State, opts: LoopOptions, target: Target, trust: float, folder
             local = folder / Path(file).name
             gait = read_gait_file(local if local.is_file() else file)
         trial = Trial(gait, doc["frequency_hz"], doc["cycles"], doc["file"])
-        return Recommendation(trial, doc["score"], doc["unit"], doc["reason"], doc["mean"], doc["sd"])
+        return Recommendation(
+            trial, doc["score"], doc["unit"], doc["reason"], doc["mean"], doc["sd"]
+        )
     if opts.goal == "gait":
         rec, _, _ = recommend_gait(
-            state.ensemble, state.support, state.gaits, target, trust, opts.cycles,
-            f"{state.loop_name}-it{it}.toml", max_evals=opts.max_evals,
+            state.ensemble,
+            state.support,
+            state.gaits,
+            target,
+            trust,
+            opts.cycles,
+            f"{state.loop_name}-it{it}.toml",
+            max_evals=opts.max_evals,
         )
     else:
         rec = recommend_map(state.ensemble, target, opts.cycles)[0]
@@ -406,7 +443,9 @@ def _next_trust(trust, rec, state, target, before) -> float:
         factor = GROW if real_gain > 0 else SHRINK
     else:
         rho = real_gain / predicted_gain
-        factor = (GROW_FAST if rho > 1.5 else GROW) if rho > 0.75 else (1.0 if rho >= 0.25 else SHRINK)
+        factor = (
+            (GROW_FAST if rho > 1.5 else GROW) if rho > 0.75 else (1.0 if rho >= 0.25 else SHRINK)
+        )
     return float(min(TRUST_MAX, trust * factor))
 
 
@@ -467,7 +506,11 @@ def _from_row(r) -> LoopIteration:
         best: Gait = FourierGait.from_vector(doc["coefficients"], doc["name"])
     else:
         best = NamedGait(doc["name"])
-    trial = {"gait": r.trial_gait, "frequency_hz": float(r.trial_frequency_hz), "cycles": int(r.trial_cycles)}
+    trial = {
+        "gait": r.trial_gait,
+        "frequency_hz": float(r.trial_frequency_hz),
+        "cycles": int(r.trial_cycles),
+    }
     return LoopIteration(
         int(r.iteration),
         trial,

@@ -103,11 +103,11 @@ def recommend_map(
     """The ``n`` trials of ``cycles`` cycles that remove the most bootstrap variance of
     the target's predictions (see the module docstring), best first."""
     pairs = target.pairs()
-    variance = np.array(
-        [ensemble.displacement_spread([g], f)[0] for g, f in pairs]
-    )
+    variance = np.array([ensemble.displacement_spread([g], f)[0] for g, f in pairs])
     candidates = declared_levels() + [
-        (g, f) for g, file in zip(target.gaits, target.files, strict=False) for f in target.frequencies_hz
+        (g, f)
+        for g, file in zip(target.gaits, target.files, strict=False)
+        for f in target.frequencies_hz
     ]
     recs = []
     for gait, freq in candidates:

@@ -105,5 +105,7 @@ class TargetTruth:
         sq = []
         for (g, f), truth in zip(self.target.pairs(), self.motions, strict=True):
             m = fitted.motion(g, f)
-            sq.append((m.forward_mm - truth.forward_mm) ** 2 + (m.lateral_mm - truth.lateral_mm) ** 2)
+            sq.append(
+                (m.forward_mm - truth.forward_mm) ** 2 + (m.lateral_mm - truth.lateral_mm) ** 2
+            )
         return float(np.sqrt(np.mean(sq)))
