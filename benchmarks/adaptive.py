@@ -13,7 +13,8 @@ recorded cycles (warm-up included), five ways of spending robot time:
   starts) of the same Fourier gait's 10 coefficients, each evaluation one trial of
   `--cycles` cycles whose forward displacement per cycle is measured on the trial itself
   (actuator noise included, cycles after the first averaged); no map;
-- ``designer`` (with --designer): `gait design --iterations 5 --verify` from the full grid.
+- ``designer`` (with --designer): `gait design --iterations 5 --verify` from the full grid
+  (also GMR's error on the unseen gaits learned from the full grid, the map goal's bar).
 
 Every arm's best gait is scored the same way, on the simulator with the gait followed
 exactly (`suds_exp.gait.truth`): the gait-goal curve is that forward displacement per
@@ -179,16 +180,42 @@ def arm_bo(seed: int, budget: int, cycles: int, bound: float) -> list[dict]:
     return rows
 
 
-def arm_designer(seed: int, bound: float, work: Path) -> dict:
+def arm_designer(seed: int, bound: float, truth: TargetTruth, work: Path) -> dict:
+    """The full grid: its GMR map's error on the unseen gaits, then `gait design
+    --iterations 5 --verify` from it (the best verified gait)."""
     store = Store(work / "grid.duckdb")
     ds = simulate_dataset(work / "grid", seed=seed)
     ingest_paths(store, [], manifest=ds.manifest, progress=False)
     preprocess(store, progress=False)
     cycles = int(round(sum(s.n_cycles for s in plan_trials(seed=seed))))
+    error = truth.map_error(fit_map(get_version(store).samples()))
     opts = DesignOptions(bound=bound, iterations=5, verify=True)
     design = design_gait(store, None, opts, work / "design")
     best = max(it.achieved.forward_mm for it in design.iterations)
-    return {"cycles": cycles + 5 * opts.cycles, "best_forward_mm": best}
+    return {
+        "cycles": cycles + 5 * opts.cycles,
+        "best_forward_mm": best,
+        "grid_cycles": cycles,
+        "grid_map_error_mm": error,
+    }
+
+
+def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[list[dict], float]:
+    """One arm's curve rows on dataset ``seed`` within ``budget`` cycles, and its wall s."""
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        if arm == "grid":
+            rows = arm_grid(seed, budget, truth, work)
+        elif arm == "random":
+            rows = arm_random(seed, budget, args.cycles, args.bound, truth, work)
+        elif arm == "plan":
+            rows = arm_plan(seed, budget, goal, args.bound, args.cycles, work)
+        elif arm == "bo":
+            rows = arm_bo(seed, args.bo_budget, args.cycles, args.bound)
+        else:
+            rows = [arm_designer(seed, args.bound, truth, work)]
+    return rows, time.perf_counter() - started
 
 
 def first_reaching(rows: list[dict], level: float) -> int | None:
@@ -208,33 +235,19 @@ def main() -> None:
     ap.add_argument("--cycles", type=int, default=5, help="cycles per planned/random/BO trial")
     ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
     ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
-    ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms")
+    ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms ('' for none)")
     ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
     ap.add_argument("--out", type=Path, default=Path("reports/adaptive"))
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     seeds = [int(s) for s in args.seeds.split(",")]
-    arms = args.arms.split(",")
+    arms = [a for a in args.arms.split(",") if a]
     truth = TargetTruth(Target.of(bound=args.bound))
     curves, summary = [], {"ceiling_mm": args.ceiling, "seeds": seeds, "arms": {}}
     for seed in seeds:
         for arm in arms + (["designer"] if args.designer else []):
-            started = time.perf_counter()
-            with tempfile.TemporaryDirectory() as tmp:
-                work = Path(tmp)
-                if arm == "grid":
-                    rows = arm_grid(seed, args.budget, truth, work)
-                elif arm == "random":
-                    rows = arm_random(seed, args.budget, args.cycles, args.bound, truth, work)
-                elif arm == "plan":
-                    rows = arm_plan(seed, args.budget, "gait", args.bound, args.cycles, work)
-                elif arm == "bo":
-                    rows = arm_bo(seed, args.bo_budget, args.cycles, args.bound)
-                else:
-                    rows = [arm_designer(seed, args.bound, work)]
-            seconds = time.perf_counter() - started
-            for r in rows:
-                curves.append({"goal": "gait", "arm": arm, "seed": seed} | r)
+            rows, seconds = run_arm(arm, "gait", seed, args.budget, args, truth)
+            curves += [{"goal": "gait", "arm": arm, "seed": seed} | r for r in rows]
             last = rows[-1]
             entry = {
                 "cycles": last["cycles"],
@@ -244,30 +257,21 @@ def main() -> None:
                 "cycles_to_90": first_reaching(rows, 0.9 * args.ceiling),
                 "seconds": round(seconds, 1),
             }
+            if arm == "designer":
+                entry["grid_cycles"] = last["grid_cycles"]
+                entry["grid_map_error_mm"] = round(last["grid_map_error_mm"], 3)
             summary["arms"].setdefault(arm, {})[str(seed)] = entry
             print(f"gait seed {seed} {arm}: {entry}", flush=True)
-        if args.map_budget > 0:
-            for arm in ("grid", "random", "plan"):
-                started = time.perf_counter()
-                with tempfile.TemporaryDirectory() as tmp:
-                    work = Path(tmp)
-                    if arm == "grid":
-                        rows = arm_grid(seed, args.map_budget, truth, work)
-                    elif arm == "random":
-                        rows = arm_random(
-                            seed, args.map_budget, args.cycles, args.bound, truth, work
-                        )
-                    else:
-                        rows = arm_plan(seed, args.map_budget, "map", args.bound, args.cycles, work)
-                for r in rows:
-                    curves.append({"goal": "map", "arm": arm, "seed": seed} | r)
-                entry = {
-                    "cycles": rows[-1]["cycles"],
-                    "map_error_mm": round(rows[-1]["map_error_mm"], 3),
-                    "seconds": round(time.perf_counter() - started, 1),
-                }
-                summary.setdefault("map", {}).setdefault(arm, {})[str(seed)] = entry
-                print(f"map seed {seed} {arm}: {entry}", flush=True)
+        for arm in ("grid", "random", "plan") if args.map_budget > 0 else ():
+            rows, seconds = run_arm(arm, "map", seed, args.map_budget, args, truth)
+            curves += [{"goal": "map", "arm": arm, "seed": seed} | r for r in rows]
+            entry = {
+                "cycles": rows[-1]["cycles"],
+                "map_error_mm": round(rows[-1]["map_error_mm"], 3),
+                "seconds": round(seconds, 1),
+            }
+            summary.setdefault("map", {}).setdefault(arm, {})[str(seed)] = entry
+            print(f"map seed {seed} {arm}: {entry}", flush=True)
     frame = pd.DataFrame(curves)
     frame.to_csv(args.out / "curves.csv", index=False, float_format="%.4f")
     (args.out / "summary.json").write_text(json.dumps(summary, indent=2))

@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from suds_exp.gait.design import circle, optimise_gait
 from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, paper_gaits, within_bound
@@ -87,8 +88,7 @@ def _path_features(gait: Gait, n: int = 64) -> np.ndarray:
 
 def visited_share(candidate: Gait, target: Gait) -> float:
     """Share (0..1) of ``target``'s path within `VISIT_RADIUS` of ``candidate``'s."""
-    support = Support(candidate.cycle(64)[1], _path_features(candidate))
-    d = support._feature_tree.query(_path_features(target))[0]
+    d = cKDTree(_path_features(candidate)).query(_path_features(target))[0]
     return float(np.mean(d <= VISIT_RADIUS))
 
 
