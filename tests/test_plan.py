@@ -172,34 +172,59 @@ def test_a_tiny_loop_stores_its_iterations_and_prints_the_json_layout(tmp_path):
     assert n == 2
 
 
-def test_the_gait_goal_records_designed_gaits_within_the_bound(tmp_path):
-    store = Store(tmp_path / "g.duckdb")
-    loop = run_loop(store, tiny(goal="gait", budget_cycles=9, bound=1.2), out=tmp_path / "o")
+@pytest.fixture(scope="module")
+def gait_loop(tmp_path_factory) -> tuple[Path, object]:
+    """A tiny gait-goal loop from an empty database: warm-up and one designed gait."""
+    work = tmp_path_factory.mktemp("plan-gait")
+    db = work / "g.duckdb"
+    loop = run_loop(Store(db), tiny(goal="gait", budget_cycles=9, bound=1.2), out=work / "o")
+    return db, loop
+
+
+def test_the_gait_goal_records_designed_gaits_within_the_bound(gait_loop):
+    db, loop = gait_loop
     first, planned = loop.iterations
     assert planned.trial["gait"].endswith("-it1.toml") and planned.cycles_recorded == 9
     assert "expected improvement" in planned.reason
-    assert max(np.abs(planned.best_gait.cycle()[1]).max(), 0) <= 1.2 + 1e-9
+    assert np.abs(planned.best_gait.cycle()[1]).max() <= 1.2 + 1e-9
     assert planned.achieved_forward_mm > 0 and first.trust_radius > 0
+    gaits = Store(db).query_df("SELECT gait FROM trials ORDER BY id")["gait"].tolist()
+    assert gaits == ["O", planned.trial["gait"]]
 
 
-def test_an_interrupted_loop_keeps_what_was_stored_and_continues(tmp_path):
+def test_an_interrupted_loop_keeps_what_was_stored_and_continues(tmp_path, monkeypatch):
+    import suds_exp.plan.loop as loop_module
+
     store = Store(tmp_path / "r.duckdb")
     out = tmp_path / "o"
     opts = tiny(goal="map", budget_cycles=13, seed=5)
+    store_iteration = loop_module._store_iteration
 
-    def interrupt(it):
-        raise KeyboardInterrupt
+    def killed_before_storing_iteration_2(st, loop_id, it):
+        # the worst moment: iteration 2's trial is recorded and preprocessed, its row not
+        if it.iteration == 2:
+            raise KeyboardInterrupt
+        store_iteration(st, loop_id, it)
 
+    monkeypatch.setattr(loop_module, "_store_iteration", killed_before_storing_iteration_2)
     with pytest.raises(KeyboardInterrupt):
-        run_loop(store, opts, out=out, on_iteration=interrupt)
+        run_loop(store, opts, out=out)
     kept = store.query_df("SELECT iteration, trial_id FROM plan_iterations ORDER BY 1")
     assert kept["iteration"].tolist() == [0, 1]
+    n_trials = store.query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0]
+    assert n_trials == 3
+    monkeypatch.setattr(loop_module, "_store_iteration", store_iteration)
     loop = run_loop(store, opts, out=out)
     rows = store.query_df("SELECT iteration, trial_id FROM plan_iterations ORDER BY 1")
     assert rows["iteration"].tolist() == [0, 1, 2]
     assert rows["trial_id"].iloc[:2].tolist() == kept["trial_id"].tolist()
     assert [it.cycles_recorded for it in loop.iterations] == [5, 9, 13]
-    # a larger budget continues the same loop; an exhausted one records nothing more
+    # the trial recorded before the interruption is the one iteration 2 stores: no new one
+    assert store.query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0] == n_trials
+    assert (
+        rows["trial_id"].iloc[2] == store.query_df("SELECT max(id) AS m FROM trials")["m"].iloc[0]
+    )
+    # one loop, found again by its name; run once more with its budget spent: no change
     assert store.query_df("SELECT count(*) AS n FROM plan_loops")["n"].iloc[0] == 1
     before = dump_db(store.path)
     run_loop(store, opts, out=out)
@@ -212,9 +237,9 @@ def test_an_interrupted_loop_keeps_what_was_stored_and_continues(tmp_path):
     "analysis.categories on their condition) until the design-axis function of branch wt-exp "
     "is called at suds_exp.plan.record.add_trial_to_version",
 )
-def test_run_report_and_findings_work_on_the_version_after_a_gait_loop(tmp_path):
+def test_run_report_and_findings_work_on_the_version_after_a_gait_loop(gait_loop, tmp_path):
     db = tmp_path / "run.duckdb"
-    run_loop(Store(db), tiny(goal="gait", budget_cycles=9), out=tmp_path / "o")
+    shutil.copy(gait_loop[0], db)
     ok(
         "run", "after", "--models", "GMR", "--boots", "1", "--train-cycles", "3",
         "--skip-infeasible", "--db", str(db), "-q",
