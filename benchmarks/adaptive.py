@@ -84,7 +84,8 @@ class Learner:
         self.achieved: dict[str, float] = {}
 
     def record(self, trial: Trial, seed: int) -> None:
-        trial_id = record_trial(self.store, trial, self.work / f"t{len(self.gaits)}", seed)
+        # one folder a trial: a declared level's folder keeps its repeat number
+        trial_id = record_trial(self.store, trial, self.work / f"t{len(self.rows)}", seed)
         if self.version is None:
             preprocess(self.store, trials=[trial_id], progress=False)
             self.version = get_version(self.store)
@@ -262,6 +263,7 @@ def main() -> None:
                 entry["grid_map_error_mm"] = round(last["grid_map_error_mm"], 3)
             summary["arms"].setdefault(arm, {})[str(seed)] = entry
             print(f"gait seed {seed} {arm}: {entry}", flush=True)
+            save(curves, summary, args.out)
         for arm in ("grid", "random", "plan") if args.map_budget > 0 else ():
             rows, seconds = run_arm(arm, "map", seed, args.map_budget, args, truth)
             curves += [{"goal": "map", "arm": arm, "seed": seed} | r for r in rows]
@@ -272,11 +274,16 @@ def main() -> None:
             }
             summary.setdefault("map", {}).setdefault(arm, {})[str(seed)] = entry
             print(f"map seed {seed} {arm}: {entry}", flush=True)
-    frame = pd.DataFrame(curves)
-    frame.to_csv(args.out / "curves.csv", index=False, float_format="%.4f")
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=2))
-    draw(frame, args.ceiling, args.out)
+            save(curves, summary, args.out)
+    draw(pd.DataFrame(curves), args.ceiling, args.out)
     print(f"wrote {args.out}/curves.csv, summary.json and figures")
+
+
+def save(curves: list[dict], summary: dict, out: Path) -> None:
+    """curves.csv and summary.json as they stand (after every arm: a long run that stops
+    keeps what it measured)."""
+    pd.DataFrame(curves).to_csv(out / "curves.csv", index=False, float_format="%.4f")
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
 
 
 def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
