@@ -239,9 +239,10 @@ def version_cycles(samples: pd.DataFrame) -> int:
 
 def _recorded_gaits(samples: pd.DataFrame, folder: Path) -> list[Gait]:
     """The gaits the version's trials ran that the planner knows: the paper's gaits and
-    the loop's own gait files (under ``folder``); at least the paper's O."""
+    the gait files under ``folder`` (a loop's, or those `plan next` wrote there and the
+    user recorded), matched by name; at least the paper's O."""
     labels = sorted(set(samples["gait"].dropna().astype(str)))
-    files = {p.name: p for p in folder.glob("it*/*.toml")}
+    files = {p.name: p for p in folder.glob("**/*.toml")}
     gaits: list[Gait] = []
     for label in labels:
         if label in GAITS:
