@@ -861,14 +861,13 @@ def plan_next_cmd(
     Example: suds-exp plan next --goal gait --bound 1.3 --json
     """
     from suds_exp.commands.plan import next_command, next_lines
-    from suds_exp.commands.simulate import parse_freqs
 
     doc = next_command(
         open_store(db),
         prep,
         goal,
         target or [],
-        parse_freqs(freqs) if freqs else (),
+        freqs,
         bound,
         n,
         cycles,
@@ -887,7 +886,7 @@ def plan_next_cmd(
 @command(
     on=plan_app,
     name="loop",
-    flags={"target_frequencies_hz": "--freqs", "target_files": "--target"},
+    flags={"frequencies_hz": "--freqs", "target_files": "--target"},
 )
 def plan_loop_cmd(
     goal: GoalOption = "gait",
@@ -917,20 +916,10 @@ def plan_loop_cmd(
 
     Example: suds-exp plan loop --goal gait --bound 1.3 --budget-cycles 50 --seed 1 --json
     """
-    from suds_exp.commands.plan import iteration_line, loop_command, loop_lines
-    from suds_exp.commands.simulate import build_config, parse_freqs
-    from suds_exp.plan import LoopOptions
+    from suds_exp.commands.plan import iteration_line, loop_command, loop_lines, loop_options
+    from suds_exp.commands.simulate import build_config
 
-    options = LoopOptions(
-        goal=goal,
-        bound=bound,
-        budget_cycles=budget_cycles,
-        seed=seed,
-        cycles=cycles,
-        learner=learner,
-        target_files=tuple(str(p) for p in target or ()),
-        target_frequencies_hz=parse_freqs(freqs) if freqs else (),
-    )
+    options = loop_options(goal, bound, budget_cycles, seed, cycles, learner, target, freqs)
     say = None if (json_ or quiet) else (lambda it: console.out.print(iteration_line(it)))
     doc = loop_command(
         open_store(db),

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+from suds_exp.commands.simulate import parse_freqs
 from suds_exp.plan import LoopOptions, Target, plan_next, run_loop
 from suds_exp.sim import SimConfig
 
@@ -15,7 +16,7 @@ def next_command(
     prep=None,
     goal: str = "map",
     gait_files: Sequence[Path] = (),
-    frequencies_hz: Sequence[float] = (),
+    freqs: str | None = None,
     bound: float = 1.3,
     n: int = 1,
     cycles: int = 5,
@@ -24,9 +25,9 @@ def next_command(
     seed: int = 0,
     n_boot: int = 6,
 ) -> dict:
-    """`plan next`: the recommendations of `plan_next` as a dict (the target's files and
-    bound are checked before the version is read)."""
-    target = Target.of(gait_files, frequencies_hz, bound)
+    """`plan next`: the recommendations of `plan_next` as a dict (the target's files,
+    frequencies ``freqs``, e.g. "1/2,1", and bound are checked before the version is read)."""
+    target = Target.of(gait_files, parse_freqs(freqs) if freqs else (), bound)
     advice = plan_next(store, prep, goal, target, n, cycles, out, learner, n_boot, seed=seed)
     return advice.to_dict()
 
@@ -43,6 +44,30 @@ def next_lines(doc: dict) -> list[str]:
     if doc["stop"]:
         lines.append(doc["stop"]["message"])
     return lines
+
+
+def loop_options(
+    goal: str,
+    bound: float,
+    budget_cycles: int,
+    seed: int,
+    cycles: int,
+    learner: str,
+    target: Sequence[Path] | None,
+    freqs: str | None,
+) -> LoopOptions:
+    """`plan loop`'s options as a `LoopOptions` (target frequencies ``freqs`` as
+    "1/2,1"; none: the default target's)."""
+    return LoopOptions(
+        goal=goal,
+        bound=bound,
+        budget_cycles=budget_cycles,
+        seed=seed,
+        cycles=cycles,
+        learner=learner,
+        target_files=tuple(str(p) for p in target or ()),
+        target_frequencies_hz=parse_freqs(freqs) if freqs else (),
+    )
 
 
 def loop_command(

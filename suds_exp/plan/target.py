@@ -78,7 +78,7 @@ class Target:
         bound = check_bound(bound)
         for f in frequencies_hz:
             if not f > 0:
-                raise ConfigError(f"frequency {f!r}: must be > 0 Hz", param="freq")
+                raise ConfigError(f"frequencies_hz {f!r}: must be > 0 Hz", param="frequencies_hz")
         gaits = [read_gait_file(p) for p in gait_files] or unseen_gaits()
         freqs = tuple(float(f) for f in frequencies_hz) or (DEFAULT_FREQUENCY_HZ,)
         return cls(gaits, freqs, bound, tuple(str(p) for p in gait_files))
