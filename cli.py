@@ -858,5 +858,121 @@ def gait_connection(
         console.out.print(line)
 
 
+plan_app = typer.Typer(
+    help="Plan the next recording: which trial teaches the map most or improves the best "
+    "gait, and when more data stops helping; the closed loop on the simulator.",
+    no_args_is_help=True,
+)
+app.add_typer(plan_app, name="plan")
+GoalOption = Annotated[
+    str, typer.Option(help="map: learn the map over the target; gait: the best gait in the bound.")
+]
+
+
+@command(
+    on=plan_app,
+    name="next",
+    flags={"frequencies_hz": "--freqs", "gait_files": "--target", "n_boot": "--boot"},
+)
+def plan_next_cmd(
+    goal: GoalOption = "map",
+    target: Annotated[
+        list[Path] | None, typer.Option(help="Target gait file (CSV or TOML); repeatable.")
+    ] = None,
+    freqs: Annotated[str | None, typer.Option(help="Target frequencies, Hz (default 1/2).")] = None,
+    bound: Annotated[float, typer.Option(help="Joint bound of a designed gait, rad.")] = 1.3,
+    n: Annotated[int, typer.Option(help="Trials to recommend (map goal).")] = 1,
+    cycles: Annotated[int, typer.Option(help="Cycles per recommended trial.")] = 5,
+    prep: PrepOption = None,
+    learner: LearnerOption = "GMR",
+    out: Annotated[Path, typer.Option(help="Folder for a new gait's file.")] = Path("plan-next"),
+    seed: Annotated[int, typer.Option(help="Seed of the bootstrap refits.")] = 0,
+    boot: Annotated[int, typer.Option(help="Bootstrap refits for the uncertainty.")] = 6,
+    db: DbOption = None,
+    json_: JsonOption = False,
+) -> None:
+    """Recommend the next trial(s) to record, each with its reason (expected reduction of
+    the target's prediction variance, or expected improvement of the best gait), and say
+    whether more data of this kind still helps (the learning curve).
+
+    Example: suds-exp plan next --goal gait --bound 1.3 --json
+    """
+    from suds_exp.commands.plan import next_command, next_lines
+
+    doc = next_command(
+        open_store(db),
+        prep,
+        goal,
+        target or [],
+        freqs,
+        bound,
+        n,
+        cycles,
+        out,
+        learner,
+        seed,
+        boot,
+    )
+    if json_:
+        console.print_json(doc)
+        return
+    for line in next_lines(doc):
+        console.out.print(line, markup=False, highlight=False)
+
+
+@command(
+    on=plan_app,
+    name="loop",
+    flags={"frequencies_hz": "--freqs", "target_files": "--target"},
+)
+def plan_loop_cmd(
+    goal: GoalOption = "gait",
+    bound: Annotated[float, typer.Option(help="Joint bound |phi1|, |phi2| <= RAD.")] = 1.3,
+    budget_cycles: Annotated[
+        int, typer.Option(help="Cycles the loop may record, its warm-up included.")
+    ] = 50,
+    seed: Annotated[int, typer.Option(help="Seed of the loop (trials and refits).")] = 0,
+    cycles: Annotated[int, typer.Option(help="Cycles per planned trial.")] = 5,
+    target: Annotated[
+        list[Path] | None, typer.Option(help="Target gait file (CSV or TOML); repeatable.")
+    ] = None,
+    freqs: Annotated[str | None, typer.Option(help="Target frequencies, Hz (default 1/2).")] = None,
+    prep: PrepOption = None,
+    learner: LearnerOption = "GMR",
+    out: Annotated[Path, typer.Option(help="Folder for the loop's captures and gaits.")] = Path(
+        "plan-loop"
+    ),
+    config: SimConfigOption = None,
+    db: DbOption = None,
+    json_: JsonOption = False,
+    quiet: QuietOption = False,
+) -> None:
+    """The closed loop with the simulator as the robot: plan a trial, record it, ingest and
+    preprocess it into the version, refit; every iteration stored (table plan_iterations).
+    Starts from 5 cycles of O at 1/2 Hz when there is no version; run again to continue.
+
+    Example: suds-exp plan loop --goal gait --bound 1.3 --budget-cycles 50 --seed 1 --json
+    """
+    from suds_exp.commands.plan import iteration_line, loop_command, loop_lines, loop_options
+    from suds_exp.commands.simulate import build_config
+
+    options = loop_options(goal, bound, budget_cycles, seed, cycles, learner, target, freqs)
+    say = None if (json_ or quiet) else (lambda it: console.out.print(iteration_line(it)))
+    doc = loop_command(
+        open_store(db),
+        options,
+        prep,
+        out,
+        build_config(config, []) if config else None,
+        progress=not (quiet or json_),
+        say=say,
+    )
+    if json_:
+        console.print_json(doc)
+        return
+    for line in loop_lines(doc):
+        console.out.print(line, markup=False, highlight=False)
+
+
 if __name__ == "__main__":
     app()

@@ -94,6 +94,7 @@ def test_how_to_guides_run(page, tmp_path, monkeypatch):
         "how-to/learner-survey.md",
         "how-to/streams.md",
         "how-to/own-experiment.md",
+        "how-to/plan-your-next-recording.md",
     ],
 )
 def test_long_how_to_guides_run(page, tmp_path, monkeypatch):

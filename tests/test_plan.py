@@ -1,0 +1,248 @@
+"""`plan next` and `plan loop` through the CLI, the library and SQL on a tiny simulated
+dataset: recommendations with reasons, the loop's stored iterations and JSON, resuming
+after an interruption, and bad input refused with the database left unchanged."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cli import app
+from suds_exp.gait.shape import read_gait_file
+from suds_exp.plan import LoopOptions, Target, plan_next, run_loop
+from suds_exp.store import Store
+from tests.conftest import assert_same_db, dump_db
+
+runner = CliRunner()
+
+
+def ok(*args: str) -> str:
+    r = runner.invoke(app, list(args))
+    assert r.exit_code == 0, r.output + (r.stderr or "")
+    return r.stdout
+
+
+def refused(*args: str) -> str:
+    r = runner.invoke(app, list(args))
+    assert r.exit_code == 2, r.output
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    return r.stderr
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory) -> Path:
+    """O at 1/2 Hz, one trial of 10 cycles, ingested and preprocessed (version v1), and a
+    second version (v2) whose shape has four actuated coordinates (cartesian r_a)."""
+    work = tmp_path_factory.mktemp("plan-small")
+    db = work / "small.duckdb"
+    ok(
+        "simulate", "--out", str(work / "d"), "--gaits", "O", "--freqs", "1/2",
+        "--repeats", "1", "--cycles", "10", "--ingest", "--db", str(db), "-q",
+    )  # fmt: skip
+    ok("preprocess", "--db", str(db), "-q")
+    ok("preprocess", "--name", "cart", "--param", "ra_repr=cartesian", "--db", str(db), "-q")
+    return db
+
+
+@pytest.fixture
+def db(small, tmp_path) -> Path:
+    copy = tmp_path / "db.duckdb"
+    shutil.copy(small, copy)
+    return copy
+
+
+def test_next_map_recommends_declared_levels_with_reasons_and_a_stop_signal(db, tmp_path):
+    doc = json.loads(
+        ok(
+            "plan",
+            "next",
+            "--goal",
+            "map",
+            "--n",
+            "3",
+            "--boot",
+            "2",
+            "--prep",
+            "v1",
+            "--db",
+            str(db),
+            "--json",
+        )  # fmt: skip
+    )
+    recs = doc["recommendations"]
+    assert len(recs) == 3
+    scores = [r["score"] for r in recs]
+    assert scores == sorted(scores, reverse=True) and scores[0] > 0
+    for r in recs:
+        assert r["unit"] == "mm^2" and "prediction variance" in r["reason"]
+        assert r["trial"]["cycles"] == 5 and r["trial"]["frequency_hz"] > 0
+        assert r["trial"]["gait"] in ("S+", "S-", "O", "D-", "D+")
+    # ten cycles: enough for a learning curve of two sizes, one double the other
+    stop = doc["stop"]
+    assert len(stop["cycles"]) == 2 and stop["message"].split(":")[0] in ("stop", "continue")
+
+
+def test_next_gait_writes_a_new_gait_file_within_the_bound(db, tmp_path):
+    target = Target.of(bound=1.2)
+    advice = plan_next(
+        Store(db), "v1", "gait", target, out=tmp_path / "next", n_boot=2, max_evals=20
+    )
+    (rec,) = advice.to_dict()["recommendations"]
+    path = Path(rec["trial"]["gait"])
+    assert path.is_file() and advice.files == [str(path)]
+    assert rec["unit"] == "mm/cycle" and "expected improvement" in rec["reason"]
+    assert read_gait_file(path).max_abs() <= 1.2 + 1e-9
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("plan", "loop", "--budget-cycles", "0"),
+        ("plan", "loop", "--target", "no-such-gait.toml", "--goal", "map"),
+        ("plan", "loop", "--bound", "2.5"),
+        ("plan", "loop", "--prep", "cart"),
+        ("plan", "next", "--prep", "cart"),
+        ("plan", "next", "--prep", "v1", "--target", "missing.csv"),
+        ("plan", "next", "--prep", "v1", "--goal", "gait", "--bound", "2.5"),
+    ],
+    ids=["budget", "loop-target", "bound", "body", "next-body", "next-target", "next-bound"],
+)
+def test_bad_input_is_one_line_and_leaves_the_database_unchanged(db, tmp_path, args):
+    before = dump_db(db)
+    err = refused(*args, "--out", str(tmp_path / "o"), "--db", str(db))
+    assert "error:" in err
+    assert_same_db(before, dump_db(db))
+
+
+def test_bad_input_on_an_empty_folder_creates_no_database(tmp_path):
+    db = tmp_path / "none.duckdb"
+    refused("plan", "loop", "--budget-cycles", "-5", "--db", str(db))
+    assert not db.exists()
+
+
+def tiny(**kw) -> LoopOptions:
+    """A loop small enough for the default suite: two refits, a short gait search."""
+    return LoopOptions(**({"n_boot": 2, "max_evals": 20, "cycles": 4} | kw))
+
+
+def test_a_tiny_loop_stores_its_iterations_and_prints_the_json_layout(tmp_path):
+    db = tmp_path / "loop.duckdb"
+    doc = json.loads(
+        ok(
+            "plan",
+            "loop",
+            "--goal",
+            "map",
+            "--budget-cycles",
+            "10",
+            "--seed",
+            "3",
+            "--out",
+            str(tmp_path / "out"),
+            "--db",
+            str(db),
+            "--json",
+        )  # fmt: skip
+    )
+    its = doc["iterations"]
+    # warm-up (5 cycles of O at 1/2 Hz) and one planned trial of 5 cycles
+    assert [it["cycles_recorded"] for it in its] == [5, 10]
+    assert its[0]["trial"] == {"gait": "O", "frequency_hz": 0.5, "cycles": 5}
+    for it in its:
+        assert set(it["trial"]) == {"gait", "frequency_hz", "cycles"}
+        assert set(it["best_gait"]) >= {"phase_rad", "phi1_rad", "phi2_rad"}
+        for key in ("cycles_total", "predicted_forward_mm", "achieved_forward_mm", "map_error"):
+            assert np.isfinite(it[key])
+        assert it["reason"]
+    assert its[1]["cycles_total"] >= its[0]["cycles_total"] + 4
+    assert set(doc["stop"]) >= {"stop", "reason"}
+    stored = Store(db).query_df(
+        "SELECT * FROM plan_iterations WHERE loop_id = ? ORDER BY iteration", [doc["loop_id"]]
+    )
+    assert stored["cycles_recorded"].tolist() == [5, 10]
+    np.testing.assert_allclose(stored["map_error_mm"], [it["map_error"] for it in its], atol=1e-3)
+    assert stored["trial_id"].notna().all()
+    # the planned trial is data like any other: ingested and in the (only) version
+    n = Store(db).query_df("SELECT count(*) AS n FROM prep_trials")["n"].iloc[0]
+    assert n == 2
+
+
+@pytest.fixture(scope="module")
+def gait_loop(tmp_path_factory) -> tuple[Path, object]:
+    """A tiny gait-goal loop from an empty database: warm-up and one designed gait."""
+    work = tmp_path_factory.mktemp("plan-gait")
+    db = work / "g.duckdb"
+    loop = run_loop(Store(db), tiny(goal="gait", budget_cycles=9, bound=1.2), out=work / "o")
+    return db, loop
+
+
+def test_the_gait_goal_records_designed_gaits_within_the_bound(gait_loop):
+    db, loop = gait_loop
+    first, planned = loop.iterations
+    assert planned.trial["gait"].endswith("-it1.toml") and planned.cycles_recorded == 9
+    assert "expected improvement" in planned.reason
+    assert np.abs(planned.best_gait.cycle()[1]).max() <= 1.2 + 1e-9
+    assert planned.achieved_forward_mm > 0 and first.trust_radius > 0
+    gaits = Store(db).query_df("SELECT gait FROM trials ORDER BY id")["gait"].tolist()
+    assert gaits == ["O", planned.trial["gait"]]
+
+
+def test_an_interrupted_loop_keeps_what_was_stored_and_continues(tmp_path, monkeypatch):
+    import suds_exp.plan.loop as loop_module
+
+    store = Store(tmp_path / "r.duckdb")
+    out = tmp_path / "o"
+    opts = tiny(goal="map", budget_cycles=13, seed=5)
+    store_iteration = loop_module._store_iteration
+
+    def killed_before_storing_iteration_2(st, loop_id, it):
+        # the worst moment: iteration 2's trial is recorded and preprocessed, its row not
+        if it.iteration == 2:
+            raise KeyboardInterrupt
+        store_iteration(st, loop_id, it)
+
+    monkeypatch.setattr(loop_module, "_store_iteration", killed_before_storing_iteration_2)
+    with pytest.raises(KeyboardInterrupt):
+        run_loop(store, opts, out=out)
+    kept = store.query_df("SELECT iteration, trial_id FROM plan_iterations ORDER BY 1")
+    assert kept["iteration"].tolist() == [0, 1]
+    n_trials = store.query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0]
+    assert n_trials == 3
+    monkeypatch.setattr(loop_module, "_store_iteration", store_iteration)
+    loop = run_loop(store, opts, out=out)
+    rows = store.query_df("SELECT iteration, trial_id FROM plan_iterations ORDER BY 1")
+    assert rows["iteration"].tolist() == [0, 1, 2]
+    assert rows["trial_id"].iloc[:2].tolist() == kept["trial_id"].tolist()
+    assert [it.cycles_recorded for it in loop.iterations] == [5, 9, 13]
+    # the trial recorded before the interruption is the one iteration 2 stores: no new one
+    assert store.query_df("SELECT count(*) AS n FROM trials")["n"].iloc[0] == n_trials
+    assert (
+        rows["trial_id"].iloc[2] == store.query_df("SELECT max(id) AS m FROM trials")["m"].iloc[0]
+    )
+    # one loop, found again by its name; run once more with its budget spent: no change
+    assert store.query_df("SELECT count(*) AS n FROM plan_loops")["n"].iloc[0] == 1
+    before = dump_db(store.path)
+    run_loop(store, opts, out=out)
+    assert_same_db(before, dump_db(store.path))
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="a loop's gait-file trials are in no declared experiment axis (report fails in "
+    "analysis.categories on their condition) until the design-axis function of branch wt-exp "
+    "is called at suds_exp.plan.record.add_trial_to_version",
+)
+def test_run_report_and_findings_work_on_the_version_after_a_gait_loop(gait_loop, tmp_path):
+    db = tmp_path / "run.duckdb"
+    shutil.copy(gait_loop[0], db)
+    ok(
+        "run", "after", "--models", "GMR", "--boots", "1", "--train-cycles", "3",
+        "--skip-infeasible", "--db", str(db), "-q",
+    )  # fmt: skip
+    ok("report", "after", "--out", str(tmp_path / "report"), "--db", str(db))
+    ok("findings", "after", "--db", str(db))
