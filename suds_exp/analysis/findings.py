@@ -27,7 +27,7 @@ from __future__ import annotations
 import hashlib
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -643,7 +643,8 @@ def findings_summary(table: pd.DataFrame) -> pd.DataFrame:
         else:
             verdict = "holds"
         rows.append({"finding": finding, "verdict": verdict, "parts": ", ".join(g["id"])})
-    return pd.DataFrame(rows)
+    # columns named even when nothing was measured (a design where no statistic applies)
+    return pd.DataFrame(rows, columns=["finding", "verdict", "parts"])
 
 
 #: What the findings say on a design other than the paper's (``{source}``: its file).
@@ -670,7 +671,13 @@ def findings(store, campaign: str, design=None, **kwargs) -> pd.DataFrame:
         )
     table = findings_table(load_results(store, campaign), campaign=campaign, **kwargs)
     design = design_for(store, design)
-    return table if is_paper(design) else for_design(table, design.source)
+    if is_paper(design):
+        return table
+    source = design.source
+    declared = type(design)(tuple(replace(a, added=()) for a in design.axes), design.source)
+    if is_paper(declared):  # the paper's, with conditions added after it (verify, plan loop)
+        source = f"{source} with {len(design.added_labels)} added level(s)"
+    return for_design(table, source)
 
 
 def for_design(table: pd.DataFrame, source: str) -> pd.DataFrame:

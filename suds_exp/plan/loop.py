@@ -39,6 +39,7 @@ from suds_exp.gait.predict import derive_seed
 from suds_exp.gait.shape import FourierGait, Gait, NamedGait, read_gait_file
 from suds_exp.gait.support import Support
 from suds_exp.gait.truth import simulate_gaits
+from suds_exp.ingest import stored_design, trial_level_axis
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
 from suds_exp.plan.curve import learning_curve
@@ -297,6 +298,9 @@ def run_loop(
     version = _existing_version(store, prep)
     if version is not None:
         check_body(version)
+    if store.path.exists():
+        # refused before anything is stored: where the loop's gait-file trials would go
+        trial_level_axis(stored_design(store))
     name = opts.name()
     folder = Path(out) / name
     folder.mkdir(parents=True, exist_ok=True)
@@ -360,7 +364,13 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
             rec = _plan(state, opts, target, trust, folder / f"it{it}", it)
             seed = derive_seed("plan-record", name, it) % 2**31
             trial_id = add_trial_to_version(
-                store, state.version, rec.trial, folder / f"it{it}", seed, config
+                store,
+                state.version,
+                rec.trial,
+                folder / f"it{it}",
+                seed,
+                config,
+                added_by=f"plan loop {name}",
             )
             before = state.best_predicted
             state = _State(store, version, opts, target, truth, folder, name, it, achieved)

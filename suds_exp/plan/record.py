@@ -4,9 +4,11 @@ seed), ingest its capture and preprocess it into the version.
 
 `add_trial_to_version` is the one place a plan's trial joins the stored data. Its capture
 is ingested by the ordinary manifest path (a declared level with the paper's condition, a
-gait file with the file's name as its gait), so nothing here is special to plans; a
-trial recorded twice (a loop resumed after a kill) is the same file, which ingest skips
-as already stored and preprocessing as already done.
+gait file with the file's name as its gait), and a gait file's trial becomes an added
+level of the stored experiment design (`suds_exp.ingest.add_trial_levels`, as `gait
+design --verify`'s), so `run`, `report` and `findings` take it as a condition; a trial
+recorded twice (a loop resumed after a kill) is the same file, which ingest skips as
+already stored, preprocessing as already done and the design as already added.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import sqlalchemy as sa
 
 from suds_exp.gait.shape import FourierGait
 from suds_exp.gait.trials import simulate_gait_file
-from suds_exp.ingest import ingest_paths
+from suds_exp.ingest import add_trial_levels, ingest_paths
 from suds_exp.plan.recommend import Trial
 from suds_exp.preprocess import preprocess as run_preprocess
 from suds_exp.robot import GAITS
@@ -40,6 +42,11 @@ def next_repeat(store: Store, gait: str, frequency_hz: float, taken_by: str | No
     return int(top or 0) + 1
 
 
+def is_declared(trial: Trial) -> bool:
+    """True for a trial of a declared level (a paper gait, no gait file)."""
+    return trial.file is None and trial.gait.name in GAITS
+
+
 def record_trial(
     store: Store, trial: Trial, folder: Path, seed: int, config: SimConfig | None = None
 ) -> int:
@@ -49,7 +56,7 @@ def record_trial(
     trial is repeat 1 of its own gait (the file's name). ``seed``: the trial's seed."""
     folder.mkdir(parents=True, exist_ok=True)
     cycles = (int(trial.cycles), int(trial.cycles))
-    if trial.file is None and trial.gait.name in GAITS:
+    if is_declared(trial):
         marker = folder / "repeat.txt"
         # the repeat is chosen once and kept, so a resumed recording writes the same file
         if marker.is_file():
@@ -83,13 +90,16 @@ def add_trial_to_version(
     folder: Path,
     seed: int,
     config: SimConfig | None = None,
+    added_by: str = "plan loop",
 ) -> int:
     """Record ``trial`` (`record_trial`) and preprocess it into ``version`` (a
     `suds_exp.preprocess.Version`) with the version's own parameters; its trial id.
 
     The one call site where a plan's trials become part of the data, and so of the
-    experiment's design: today a gait file's trial carries the file's name as its gait
-    (a condition no declared axis lists yet)."""
+    experiment's design: a gait file's trial (labelled with the file's name) becomes an
+    added level of the stored design, recorded as added by ``added_by``."""
     trial_id = record_trial(store, trial, folder, seed, config)
+    if not is_declared(trial):
+        add_trial_levels(store, {trial_id: trial.gait.name}, added_by=added_by)
     run_preprocess(store, version.name, params=version.params, trials=[trial_id], progress=False)
     return trial_id
