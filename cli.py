@@ -872,7 +872,7 @@ GoalOption = Annotated[
 @command(
     on=plan_app,
     name="next",
-    flags={"frequencies_hz": "--freqs", "gait_files": "--target", "n_boot": "--boot"},
+    flags={"frequencies_hz": "--freqs", "gait_files": "--target", "n_boot": "--boots"},
 )
 def plan_next_cmd(
     goal: GoalOption = "map",
@@ -887,7 +887,7 @@ def plan_next_cmd(
     learner: LearnerOption = "GMR",
     out: Annotated[Path, typer.Option(help="Folder for a new gait's file.")] = Path("plan-next"),
     seed: Annotated[int, typer.Option(help="Seed of the bootstrap refits.")] = 0,
-    boot: Annotated[int, typer.Option(help="Bootstrap refits for the uncertainty.")] = 6,
+    boots: Annotated[int, typer.Option(help="Bootstrap refits for the uncertainty.")] = 6,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -911,7 +911,7 @@ def plan_next_cmd(
         out,
         learner,
         seed,
-        boot,
+        boots,
     )
     if json_:
         console.print_json(doc)
