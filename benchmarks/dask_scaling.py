@@ -13,11 +13,12 @@ The dataset (4 conditions, 2 repeats of 10 cycles, simulated once into a tempora
 folder, or ``--db``, a preprocessed database) is copied for every run. Each round runs,
 in turn: ``suds-exp run`` in-process (``-j 1``), with loky (``-j 2``), and with
 ``--scheduler`` on a cluster this script starts on 127.0.0.1 (``dask scheduler`` and
-``--workers`` separate ``dask worker --nthreads 1`` processes, 1 and 2 of them by
-default), stopped after each run. ``--worker-env`` sets environment variables of the
-dask workers only (to test what slows them down). Figures are medians over
+``--workers`` separate ``dask worker --nthreads 1 --no-nanny`` processes, 1 and 2 of
+them by default; ``--nanny`` keeps dask's nanny process), stopped after each run.
+``--worker-env`` sets environment variables of the dask workers only (to test what slows
+them down). Figures are medians over
 ``--rounds``; "job" is a job's ``fit_seconds + predict_seconds`` as the results table
-stores it; "worker CPU" is the user+system time of the worker processes (psutil).
+stores it.
 """
 
 from __future__ import annotations
@@ -31,12 +32,10 @@ import socket
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 from statistics import median
 
 import duckdb
-import psutil
 
 BIN = Path(sys.executable).parent
 
@@ -80,7 +79,7 @@ def _free_port() -> int:
 class _Cluster:
     """``dask scheduler`` and ``n`` ``dask worker --nthreads 1`` processes on 127.0.0.1."""
 
-    def __init__(self, n: int, env: dict[str, str]):
+    def __init__(self, n: int, env: dict[str, str], nanny: bool = False):
         port = _free_port()
         self.address = f"tcp://127.0.0.1:{port}"
         quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
@@ -105,7 +104,7 @@ class _Cluster:
                     self.address,
                     "--nthreads",
                     "1",
-                    "--no-nanny",
+                    *([] if nanny else ["--no-nanny"]),
                     "--host",
                     "127.0.0.1",
                     "--dashboard-address",
@@ -120,13 +119,6 @@ class _Cluster:
 
         with Client(self.address, timeout=30) as client:
             client.wait_for_workers(n, timeout=60)
-
-    def cpu_seconds(self) -> float:
-        total = 0.0
-        for w in self.workers:
-            t = psutil.Process(w.pid).cpu_times()
-            total += t.user + t.system
-        return total
 
     def stop(self) -> None:
         for p in [*self.workers, self.scheduler]:
@@ -182,6 +174,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=1)
     ap.add_argument("--workers", default="1,2", help="dask worker counts to run")
     ap.add_argument("--worker-env", action="append", default=[], metavar="NAME=VALUE")
+    ap.add_argument("--nanny", action="store_true", help="workers under a nanny process")
     a = ap.parse_args(argv)
     env = dict(item.split("=", 1) for item in a.worker_env)
     counts = [int(n) for n in a.workers.split(",")]
@@ -193,10 +186,8 @@ def main(argv=None) -> int:
             runs.setdefault("in-process", []).append(_run(base, folder, "one", a, ["-j", "1"]))
             runs.setdefault("loky -j 2", []).append(_run(base, folder, "loky", a, ["-j", "2"]))
             for n in counts:
-                cluster = _Cluster(n, env)
+                cluster = _Cluster(n, env, a.nanny)
                 try:
-                    before = cluster.cpu_seconds()
-                    started = time.perf_counter()
                     r = _run(
                         base,
                         folder,
@@ -204,8 +195,6 @@ def main(argv=None) -> int:
                         a,
                         ["--backend", "dask", "--scheduler", cluster.address, "-j", str(n)],
                     )
-                    r["worker_cpu"] = cluster.cpu_seconds() - before
-                    r["outer"] = time.perf_counter() - started
                 finally:
                     cluster.stop()
                 runs.setdefault(f"dask TCP, {n} worker(s)", []).append(r)
@@ -213,19 +202,16 @@ def main(argv=None) -> int:
     ref_wall, ref_job = median(r["wall"] for r in ref), median(r["job_ms"] for r in ref)
     print(
         f"{ref[0]['jobs']} jobs ({a.models}; {a.boots} draws, {a.train_cycles} cycles), "
-        f"{a.rounds} round(s), medians; worker env {env or 'default'}"
+        f"{a.rounds} round(s), medians; worker env {env or 'default'}; "
+        f"{'with' if a.nanny else 'no'} nanny"
     )
-    print(
-        f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11} "
-        f"{'worker CPU s':>12}  rows"
-    )
+    print(f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11}  rows")
     for label, rs in runs.items():
         wall, job = median(r["wall"] for r in rs), median(r["job_ms"] for r in rs)
-        cpu = f"{median(r['worker_cpu'] for r in rs):12.1f}" if "worker_cpu" in rs[0] else " " * 12
         same = "same" if {r["digest"] for r in rs} == {ref[0]["digest"]} else "DIFFER"
         print(
             f"{label:26} {wall:7.1f} {ref_wall / wall:7.2f}x {job:7.1f} {job / ref_job:10.2f}x "
-            f"{cpu}  {same}"
+            f" {same}"
         )
     return 0
 
