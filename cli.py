@@ -157,7 +157,7 @@ def ingest(
     quiet: QuietOption = False,
 ) -> None:
     """Ingest QTM TSV, C3D, Vicon Nexus / Motive / marker CSV and TRC files, and keypoint
-    files of DeepLabCut, SLEAP, Lightning Pose and Anipose (needs suds-exp[pose]).
+    files of DeepLabCut, SLEAP, Lightning Pose and Anipose (needs suds-exp\\[pose]).
 
     Each file is one transaction; a bad file is reported in one line and the others are
     still stored (exit status 2 at the end). Example: suds-exp ingest data/ --manifest

@@ -35,3 +35,9 @@ def test_the_old_name_still_parses(command, tmp_path):
     out = runner.invoke(app, [*args, COMMANDS[command], "5", "--db", str(db)])
     assert "No such option" not in out.output, out.output
     assert out.exit_code == 2  # refused for the missing campaign or file, not the option
+
+
+def test_help_keeps_the_brackets_of_an_extra():
+    """rich read ``[pose]`` as a style tag and printed "(needs suds-exp)"."""
+    out = runner.invoke(app, ["ingest", "--help"], env={"COLUMNS": "200"})
+    assert "(needs suds-exp[pose])" in out.output, out.output
