@@ -27,7 +27,7 @@ from __future__ import annotations
 import hashlib
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -674,8 +674,8 @@ def findings(store, campaign: str, design=None, **kwargs) -> pd.DataFrame:
     if is_paper(design):
         return table
     source = design.source
-    declared = type(design)(tuple(replace(a, added=()) for a in design.axes), design.source)
-    if is_paper(declared):  # the paper's, with conditions added after it (verify, plan loop)
+    # the paper's, with conditions added after it (gait design --verify, plan loop)
+    if is_paper(design.declared()):
         source = f"{source} with {len(design.added_labels)} added level(s)"
     return for_design(table, source)
 

@@ -113,6 +113,10 @@ class ExperimentDesign:
             axes.append(replace(a, added=a.added + extra) if extra and a.levels else a)
         return ExperimentDesign(tuple(axes), self.source)
 
+    def declared(self) -> ExperimentDesign:
+        """This design as declared: without the levels added after the declaration."""
+        return ExperimentDesign(tuple(replace(a, added=()) for a in self.axes), self.source)
+
     def axis(self, name: str) -> Axis:
         for a in self.axes:
             if a.name == name:
