@@ -13,7 +13,7 @@ from cli import app
 from suds_exp.campaign import run_campaign
 from suds_exp.commands.discrepancy import parse_exclude
 from suds_exp.discrepancy import DiscrepancyOptions
-from suds_exp.discrepancy.workflow import check_options
+from suds_exp.discrepancy.options import check_options
 from suds_exp.errors import CampaignError, ConfigError, DiscrepancyError, SudsError
 from suds_exp.preprocess import resolve_params
 from suds_exp.store import Store

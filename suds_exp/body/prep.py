@@ -33,22 +33,19 @@ from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.params import DEFAULTS, params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.pipeline import (
-    PLANAR_Z,
-    NewFit,
-    PrepResult,
-    find_version,
-    new_result,
-    preprocess,
-    stored_progress,
-    write_trials,
-    write_version,
-)
+from suds_exp.preprocess.pipeline import PLANAR_Z, PrepResult, new_result, preprocess
 from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
     DRP_COLUMNS,
     RP_COLUMNS,
+)
+from suds_exp.preprocess.version import (
+    NewFit,
+    find_version,
+    stored_progress,
+    write_trials,
+    write_version,
 )
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store

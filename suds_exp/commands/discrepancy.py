@@ -10,7 +10,8 @@ from suds_exp import console
 from suds_exp.commands.simulate import build_config
 from suds_exp.discrepancy import DiscrepancyOptions, DiscrepancyResult, run_discrepancy
 from suds_exp.discrepancy.discover import DiscoverySettings
-from suds_exp.discrepancy.workflow import check_exclude, default_name
+from suds_exp.discrepancy.naming import default_name
+from suds_exp.discrepancy.options import check_exclude
 from suds_exp.robot import parse_ids
 from suds_exp.sim.config import SimConfig
 

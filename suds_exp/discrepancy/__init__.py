@@ -5,13 +5,10 @@ closes the held-out gap, add it and repeat."""
 from suds_exp.discrepancy.discover import Discovery, DiscoverySettings
 from suds_exp.discrepancy.effects import Candidate, candidates_for, parse_effect_items
 from suds_exp.discrepancy.fit_candidates import FitSettings
+from suds_exp.discrepancy.options import DiscrepancyOptions, check_exclude
 from suds_exp.discrepancy.replay import ReplaySettings
-from suds_exp.discrepancy.workflow import (
-    DiscrepancyOptions,
-    DiscrepancyResult,
-    check_exclude,
-    run_discrepancy,
-)
+from suds_exp.discrepancy.result import DiscrepancyResult
+from suds_exp.discrepancy.workflow import run_discrepancy
 from suds_exp.errors import DiscrepancyError
 
 __all__ = [

@@ -10,25 +10,24 @@ from __future__ import annotations
 import dataclasses
 import datetime as _dt
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import sqlalchemy as sa
 
-from suds_exp.discrepancy.discover import Constancy, Discovery, DiscoverySettings
-from suds_exp.discrepancy.effects import Candidate, candidates_for, effect_names
+from suds_exp.discrepancy.effects import Candidate, candidates_for
 from suds_exp.discrepancy.fit_candidates import (
     CandidateResult,
-    FitSettings,
     fit_candidate,
     refine_candidate,
     score_candidates,
     trial_losses,
 )
 from suds_exp.discrepancy.localise import localise, residual_correlations, systematic_gap
+from suds_exp.discrepancy.naming import check_free, default_name, free_name
+from suds_exp.discrepancy.options import DiscrepancyOptions, check_options
 from suds_exp.discrepancy.partial import check_named, discover_step
 from suds_exp.discrepancy.replay import (
     ReplaySettings,
@@ -39,261 +38,13 @@ from suds_exp.discrepancy.replay import (
     settings_from_prep,
     window_field,
 )
+from suds_exp.discrepancy.result import DiscrepancyResult, Step
 from suds_exp.errors import DiscrepancyError
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.version import get_version
 from suds_exp.progress import progress_lines
 from suds_exp.sim.config import SimConfig
 from suds_exp.store.files import check_writable
-
-
-@dataclass
-class DiscrepancyOptions:
-    """Everything that shapes a run (stored with it).
-
-    Parameters
-    ----------
-    alpha : float
-        Level of the paired test naming an effect (the candidates tested in the order
-        of their training loss until one fails, `adjust_in_training_order`).
-    max_effects : int
-        Stop after naming this many effects.
-    seed : int
-        Seed of the trial split and the bootstraps.
-    replay : ReplaySettings, optional
-        Window cutting; None: defaults with the preprocessing version's differentiator.
-    fit : FitSettings
-    refine : bool
-        Re-fit the accepted candidate's parameter at the capture rate (no decimation), so
-        its value and interval are not biased by the replay's discretisation.
-    passive : bool
-        Compare the passive shape r_p too (when the preprocessing version has one); the
-        loss then weighs body velocity and passive shape half and half. On by default:
-        it is what makes `flippers` and `spoke_oscillation` (markers only) visible.
-    gap_floor : float
-        Held-out loss (mean squared residual over each channel's mean square, so 0.01 is
-        a residual of about 10% of the signal) below which a remaining gap is called
-        negligible even when it is statistically systematic.
-    exclude : tuple of str
-        Effects never offered as candidates: the withheld-effect
-        checks hide an effect in the data and exclude it here.
-    discover : bool
-        When no candidate is significant and a systematic gap above ``gap_floor``
-        remains, fit a sparse learned correction (`discover.py`) on the training trials
-        and add it if it passes its own held-out test at ``alpha``.
-    discovery : DiscoverySettings
-    """
-
-    alpha: float = 0.01
-    max_effects: int = 3
-    seed: int = 0
-    replay: ReplaySettings | None = None
-    fit: FitSettings = field(default_factory=FitSettings)
-    refine: bool = True
-    passive: bool = True
-    gap_floor: float = 0.01
-    exclude: tuple[str, ...] = ()
-    discover: bool = True
-    discovery: DiscoverySettings = field(default_factory=DiscoverySettings)
-
-    def __post_init__(self) -> None:
-        self.exclude = check_exclude(self.exclude)
-        if not self.discover and set(effect_names()) <= set(self.exclude):
-            raise DiscrepancyError(
-                "exclude: every candidate is excluded and discovery is off; "
-                "nothing could explain the gap",
-                param="exclude",
-            )
-
-    def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
-
-
-@dataclass
-class Step:
-    """One pass of the loop: the model replayed, its gap, the candidates, the decision."""
-
-    index: int
-    model: SimConfig
-    test_loss: float
-    test_rmse: np.ndarray
-    test_trial_loss: np.ndarray
-    localisation: pd.DataFrame
-    candidates: list[CandidateResult] = field(default_factory=list)
-    unobservable: list[str] = field(default_factory=list)
-    accepted: CandidateResult | None = None
-    decision: str = "none_significant"
-    gap_closed: float | None = None
-    systematic: tuple[float, float] = (float("nan"), 1.0)
-    correlations: pd.DataFrame | None = None
-    example: dict | None = None
-    discovery: Discovery | None = None
-    constancy: Constancy | None = None  # the accepted effect's check (`partial.py`)
-
-
-@dataclass
-class DiscrepancyResult:
-    """Outcome of a run. ``named`` lists the accepted effects in order; ``differentiator``
-    is the one the replay's rates went through (the preprocessing version's own)."""
-
-    run_id: int | None
-    name: str
-    prep_version: str | None
-    steps: list[Step]
-    train_trials: list[int]
-    test_trials: list[int]
-    start_model: SimConfig
-    final_model: SimConfig
-    outcome: str
-    seconds: float
-    cpu_seconds: float = 0.0
-    report_dir: Path | None = None
-    differentiator: Differentiator | None = None
-
-    @property
-    def named(self) -> list[dict]:
-        out = []
-        for s in self.steps:
-            a = s.accepted
-            if a is None:
-                continue
-            out.append(
-                {
-                    "step": s.index,
-                    "effect": a.candidate.effect,
-                    "candidate": a.candidate.label,
-                    "parameter": a.candidate.param,
-                    "value": a.value,
-                    "ci": list(a.ci) if a.ci is not None else None,
-                    "unit": a.candidate.unit,
-                    "p_adjusted": a.p_adjusted,
-                    "gap_before": s.test_loss,
-                    "gap_after": self.steps[s.index + 1].test_loss
-                    if s.index + 1 < len(self.steps)
-                    else None,
-                    "gap_closed": s.gap_closed,
-                    # "partial": its strength is not constant (`partial.py`), not the cause
-                    "role": "partial" if s.decision == "partial" else "cause",
-                }
-            )
-        return out
-
-    @property
-    def gap_before(self) -> float:
-        """Held-out loss of the starting model (mean normalised squared residual)."""
-        return self.steps[0].test_loss
-
-    @property
-    def gap_after(self) -> float:
-        """Held-out loss of the final model."""
-        return self.steps[-1].test_loss
-
-    @property
-    def discovery(self) -> Discovery | None:
-        """The sparse correction fitted at the last step (None when none was tried)."""
-        return self.steps[-1].discovery
-
-    @property
-    def gap_after_correction(self) -> float:
-        """Held-out loss of the final model with the learned correction when it was
-        added (significant), else `gap_after`."""
-        d = self.discovery
-        return float(np.mean(d.test_after)) if d is not None and d.significant else self.gap_after
-
-    def to_json(self) -> dict:
-        last = self.steps[-1]
-        return {
-            "run_id": self.run_id,
-            "name": self.name,
-            "prep_version": self.prep_version,
-            "differentiator": dataclasses.asdict(self.differentiator)
-            if self.differentiator is not None
-            else None,
-            "named": self.named,
-            "gap_before": self.gap_before,
-            "gap_after": self.gap_after,
-            "rmse_vx_before": float(self.steps[0].test_rmse[0]),
-            "rmse_vx_after": float(last.test_rmse[0]),
-            "steps": [
-                {
-                    "step": s.index,
-                    "test_loss": s.test_loss,
-                    "test_rmse": dict(
-                        zip(("vx", "vy", "wz"), map(float, s.test_rmse), strict=True)
-                    ),
-                    "decision": s.decision,
-                    "accepted": s.accepted.candidate.label if s.accepted else None,
-                    "candidates": [
-                        {
-                            "candidate": r.candidate.label,
-                            "value": r.value,
-                            "ci": list(r.ci) if r.ci else None,
-                            "improvement": r.improvement,
-                            "p_adjusted": r.p_adjusted,
-                            "significant": r.significant,
-                        }
-                        for r in s.candidates
-                    ],
-                    "unobservable": s.unobservable,
-                    "systematic_p": s.systematic[1],
-                    "varying_strength_p": s.constancy.p_value if s.constancy else None,
-                    "varies_with": s.constancy.varies_with if s.constancy else None,
-                    "at_range_edge": s.constancy.at_range_edge if s.constancy else None,
-                }
-                for s in self.steps
-            ],
-            "discovery": discovery_json(self.discovery),
-            "gap_after_correction": self.gap_after_correction,
-            "outcome": self.outcome,
-            "seconds": self.seconds,
-            "cpu_seconds": self.cpu_seconds,
-            "report_dir": str(self.report_dir) if self.report_dir else None,
-            "train_trials": self.train_trials,
-            "test_trials": self.test_trials,
-        }
-
-
-def discovery_json(d: Discovery | None) -> dict | None:
-    """The learned correction as plain data (None when none was tried)."""
-    if d is None:
-        return None
-    return {
-        "significant": d.significant,
-        "p_value": d.p_value,
-        "gap_before": float(np.mean(d.test_before)),
-        "gap_after": float(np.mean(d.test_after)),
-        "gap_closed": d.improvement,
-        "physics": d.physics,
-        "physics_by_part": d.physics_by_part,
-        "leading": d.leading,
-        "equations": d.equations(),
-        "terms": [
-            {
-                "channel": t.channel,
-                "feature": t.feature.name,
-                "family": t.feature.family,
-                "coef": t.coef,
-                "ci": list(t.ci),
-                "unit": t.unit,
-            }
-            for t in d.terms
-        ],
-    }
-
-
-def check_exclude(names: Sequence[str]) -> tuple[str, ...]:
-    """``names`` of effects never offered as candidates, each checked, as a tuple."""
-    known = effect_names()
-    if isinstance(names, str):
-        names = (names,)
-    out = tuple(str(x).strip() for x in names if str(x).strip())
-    for x in out:
-        if x not in known:
-            raise DiscrepancyError(
-                f"exclude {x!r}: unknown effect; expected one of {', '.join(known)}",
-                param="exclude",
-            )
-    return out
 
 
 def split_trials(info: pd.DataFrame, rng: np.random.Generator) -> tuple[list[int], list[int]]:
@@ -388,15 +139,6 @@ class Windows:
     phase: np.ndarray
     ra: np.ndarray
     t: np.ndarray
-
-
-def check_options(opts: DiscrepancyOptions) -> None:
-    """Raise `DiscrepancyError` for an ``alpha`` outside (0, 1) or a negative
-    ``max_effects``."""
-    if not 0 < opts.alpha < 1:
-        raise DiscrepancyError(f"alpha {opts.alpha}: must be between 0 and 1", param="alpha")
-    if opts.max_effects < 0:
-        raise DiscrepancyError(f"max_effects {opts.max_effects}: must be >= 0", param="max_effects")
 
 
 def load(
@@ -689,11 +431,6 @@ def run_steps(w: Windows, model: SimConfig, opts: DiscrepancyOptions, rng, say):
     return steps, current
 
 
-def default_name(when: _dt.datetime | None = None) -> str:
-    """A run's default name, ``discrepancy-<YYYYmmdd-HHMMSS>`` of ``when`` (default: now)."""
-    return f"discrepancy-{(when or _dt.datetime.now()):%Y%m%d-%H%M%S}"
-
-
 def run_discrepancy(
     store=None,
     prep: str | int | None = None,
@@ -751,48 +488,6 @@ def run_discrepancy(
             name = free_name(store, name)
         check_free(store, name, out)
         return _run(store, prep, model, name, trials, opts, out, samples, progress, started_at)
-
-
-def stored_names(store) -> set[str]:
-    """The names of the discrepancy runs stored in ``store`` (empty for a new file)."""
-    if not store.path.exists():
-        return set()
-    with store.read() as conn:
-        if not sa.inspect(conn).has_table("discrepancy_runs"):
-            return set()
-        return set(conn.execute(sa.text("SELECT name FROM discrepancy_runs")).scalars())
-
-
-def free_name(store, base: str) -> str:
-    """``base``, or ``base-2``, ``base-3``, ... when a stored run has it: two unnamed runs
-    started within the same second get names of their own."""
-    taken = stored_names(store)
-    candidates = (base, *(f"{base}-{k}" for k in range(2, len(taken) + 3)))
-    return next(n for n in candidates if n not in taken)
-
-
-def check_free(store, name: str, out: str | Path | None) -> None:
-    """Raise `DiscrepancyError` when ``name`` or the report folder ``out`` belongs to a
-    stored run already."""
-    if not store.path.exists():
-        return
-    with store.read() as conn:
-        if not sa.inspect(conn).has_table("discrepancy_runs"):
-            return
-        rows = conn.execute(sa.text("SELECT id, name, report_dir FROM discrepancy_runs")).fetchall()
-    for run_id, other, folder in rows:
-        if other == name:
-            raise DiscrepancyError(
-                f"name {name!r}: discrepancy run {run_id} already has that name; choose "
-                "another name",
-                param="name",
-            )
-        if out is not None and folder and Path(folder).resolve() == Path(out).resolve():
-            raise DiscrepancyError(
-                f"out {out}: the report folder of discrepancy run {run_id} ({other!r}); "
-                "choose another folder",
-                param="out",
-            )
 
 
 def _run(store, prep, model, name, trials, opts, out, samples, progress, started_at):

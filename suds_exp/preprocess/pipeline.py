@@ -1,11 +1,12 @@
-"""`preprocess`: markers -> samples as a stored, versioned parameter set; `load_samples`.
+"""`preprocess`: markers -> samples as a stored, versioned parameter set.
 
 A run resolves its version (same parameters = same version), reads the markers of the
 trials not yet done, cleans them and measures their geometry (any refused trial stops the
 run before anything is written), fits what the version lacks (segment origins, passive
 PCA, one Phaser per trial group) on those trials and stores it, then writes the trials'
 samples with their stats in batches, each batch in one transaction. An interrupted run
-therefore resumes with the trials not yet done, reusing the stored fit.
+therefore resumes with the trials not yet done, reusing the stored fit. Versions are read
+and written in `version.py`.
 """
 
 from __future__ import annotations
@@ -24,18 +25,19 @@ from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.body_model import BodyModel, SwimmerModel, require_markers
 from suds_exp.preprocess.clean import CleanResult, clean_tracks
 from suds_exp.preprocess.kinematics import Kinematics
-from suds_exp.preprocess.params import params_hash, params_json, resolve_params
+from suds_exp.preprocess.params import params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
 from suds_exp.preprocess.rates import Differentiator, smooth, window_frames
 from suds_exp.preprocess.reduction import passive_reducer
 from suds_exp.preprocess.shape import PassivePCA
-from suds_exp.preprocess.tables import (
-    prep_fits,
-    prep_pca,
-    prep_trials,
-    prep_versions,
+from suds_exp.preprocess.version import (
+    NewFit,
+    find_version,
+    kept_ratio,
+    stored_progress,
+    write_trials,
+    write_version,
 )
-from suds_exp.preprocess.version import require_tables as _require_tables
 from suds_exp.progress import progress_bar
 from suds_exp.robot import DRP_COLUMNS, RP_COLUMNS
 from suds_exp.store import Store
@@ -278,18 +280,6 @@ class Fitted:
     new: list[NewFit] = field(default_factory=list)
 
 
-@dataclass
-class NewFit:
-    """A fitted state to store in `prep_fits`: kind, group, JSON state, the trial ids it
-    was fitted on and their number of frames."""
-
-    kind: str
-    grp: str
-    state: str
-    trial_ids: list[int]
-    n_frames: int
-
-
 def preprocess(
     store: Store,
     name: str | None = None,
@@ -349,7 +339,7 @@ def _preprocess(store, name, params, trials, progress, started, model) -> PrepRe
     result = new_result(row, name, params, digest, skipped=meta.id[meta.id.isin(done)])
     items = clean(todo, tracks, params, progress, model)
     if not items:
-        result.explained_variance_ratio = _kept_ratio(store, result.version_id, params["k"])
+        result.explained_variance_ratio = kept_ratio(store, result.version_id, params["k"])
         result.seconds = time.perf_counter() - started
         return result
     fitted = fit(items, params, fits, model)
@@ -358,22 +348,6 @@ def _preprocess(store, name, params, trials, progress, started, model) -> PrepRe
     result.explained_variance_ratio = fitted.pca.explained_variance_ratio_[: params["k"]].tolist()
     result.seconds = time.perf_counter() - started
     return result
-
-
-def find_version(conn: sa.Connection, name: str | None, digest: str):
-    """The `prep_versions` row with parameters hash ``digest`` (None if there is none yet);
-    raises `PreprocessError` if ``name`` is already another parameter set's name."""
-    v = prep_versions.c
-    row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
-    if name is not None:
-        clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
-        if clash is not None and clash.params_hash != digest:
-            raise PreprocessError(
-                f"name {name}: version {clash.id} already has that name with other "
-                "parameters; choose another name",
-                param="name",
-            )
-    return row
 
 
 def new_result(row, name: str | None, params: dict, digest: str, skipped) -> PrepResult:
@@ -451,37 +425,6 @@ def fit(
     return Fitted(joints, pca, phasers, new)
 
 
-def write_version(
-    store: Store, result: PrepResult, new_fits: list[NewFit], pca, n_kept: int
-) -> None:
-    """Create the version of ``result`` if it is new (setting its id and name) and store
-    its new fits, in one transaction; a new PCA's components go to `prep_pca`, the first
-    ``n_kept`` kept."""
-    with store.write() as conn:
-        if result.version_id < 0:
-            vid = int(conn.exec_driver_sql("SELECT nextval('prep_versions_id_seq')").scalar_one())
-            result.name = result.name or f"v{vid}"
-            conn.execute(
-                sa.insert(prep_versions).values(
-                    id=vid,
-                    name=result.name,
-                    params_hash=result.params_hash,
-                    params=params_json(result.params),
-                    k=result.params["k"],
-                    created_at=sa.func.current_timestamp(),
-                )
-            )
-            result.version_id = vid
-        if new_fits:
-            now = pd.Timestamp.now(tz="UTC").tz_localize(None)
-            rows = [
-                {"version_id": result.version_id, **asdict(f), "fitted_at": now} for f in new_fits
-            ]
-            store.insert_df(conn, prep_fits.name, pd.DataFrame(rows))
-        if any(f.kind == "pca" for f in new_fits):
-            write_pca(store, conn, result.version_id, pca, n_kept)
-
-
 def write_samples(
     store: Store,
     result: PrepResult,
@@ -517,90 +460,5 @@ def write_samples(
                 batch = []
 
 
-def write_trials(store: Store, result: PrepResult, samples: pd.DataFrame, stats: pd.DataFrame):
-    """Store trials' samples and their `prep_trials` stats in one transaction, then
-    record them in ``result``."""
-    with store.write() as conn:
-        store.insert_df(conn, "samples", samples)
-        store.insert_df(conn, prep_trials.name, stats)
-    result.processed.extend(int(i) for i in stats.trial_id)
-    result.n_samples += len(samples)
-
-
 def _new_fit(kind: str, grp: str, state: str, items: list[_Trial]) -> NewFit:
     return NewFit(kind, grp, state, [tr.id for tr in items], int(sum(len(tr.t) for tr in items)))
-
-
-def _kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
-    frame = store.query_df(
-        "SELECT explained_variance_ratio FROM prep_pca WHERE version_id = ? AND kept "
-        "ORDER BY component",
-        [version_id],
-    )
-    if frame.empty:  # a kernel-PCA or autoencoder version: its ratio is in its stored state
-        state = store.query_df(
-            "SELECT state FROM prep_fits WHERE version_id = ? AND kind = 'reducer'", [version_id]
-        )
-        if len(state):
-            return json.loads(state.state.iloc[0])["explained_variance_ratio"][:k]
-    return frame.explained_variance_ratio.tolist()[:k]
-
-
-# -- reading samples ----------------------------------------------------------------------
-def list_versions(store: Store) -> pd.DataFrame:
-    """One row per version: id, name, params_hash, k, trials done, samples, created_at,
-    kept explained variance (fraction)."""
-    with store.read() as conn:
-        _require_tables(conn)
-    return store.query_df(
-        """
-        SELECT v.id, v.name, v.params_hash, v.k,
-               (SELECT count(*) FROM prep_trials p WHERE p.version_id = v.id) AS n_trials,
-               (SELECT count(*) FROM samples s WHERE s.version_id = v.id) AS n_samples,
-               (SELECT sum(explained_variance_ratio) FROM prep_pca c
-                 WHERE c.version_id = v.id AND c.kept) AS explained_variance_kept,
-               v.created_at, v.params
-        FROM prep_versions v ORDER BY v.id
-        """
-    )
-
-
-def write_pca(store: Store, conn: sa.Connection, version_id: int, pca, n_kept: int) -> None:
-    """Store a fitted PCA's components (``pca``: a fitted scikit-learn PCA) in
-    `prep_pca` for ``version_id``, the first ``n_kept`` marked as kept."""
-    cum = np.cumsum(pca.explained_variance_ratio_)
-    store.insert_df(
-        conn,
-        prep_pca.name,
-        pd.DataFrame(
-            {
-                "version_id": version_id,
-                "component": np.arange(1, len(cum) + 1),
-                "explained_variance": pca.explained_variance_,
-                "explained_variance_ratio": pca.explained_variance_ratio_,
-                "cumulative_ratio": cum,
-                "kept": np.arange(len(cum)) < n_kept,
-                "loadings": [list(r) for r in pca.components_],
-            }
-        ),
-    )
-
-
-def stored_progress(
-    conn: sa.Connection, version_id: int | None
-) -> tuple[set[int], dict[tuple[str, str], str]]:
-    """What version ``version_id`` already holds: the ids of its preprocessed trials and
-    its fitted states by (kind, group); both empty for a version not yet created (None)."""
-    if version_id is None:
-        return set(), {}
-    done = {
-        int(r[0])
-        for r in conn.execute(
-            sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == version_id)
-        )
-    }
-    fits = {
-        (r.kind, r.grp): r.state
-        for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == version_id))
-    }
-    return done, fits

@@ -1,4 +1,5 @@
-"""A stored preprocessing version as one object: `get_version(store, ref) -> Version`.
+"""A stored preprocessing version as one object: `get_version(store, ref) -> Version`;
+and the writers that create a version and store its fits and samples.
 
 The one way into the ``prep_*`` tables for code outside preprocessing: campaign,
 discrepancy and the truth comparison find a version, its fitted state and its samples
@@ -10,22 +11,25 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
 from suds_exp.errors import PreprocessError
-from suds_exp.preprocess.params import actuated_dimension
+from suds_exp.preprocess.params import actuated_dimension, params_json
 from suds_exp.preprocess.phaser import Phaser
 from suds_exp.preprocess.rates import Differentiator
 from suds_exp.preprocess.reduction import reducer_from_state
 from suds_exp.preprocess.shape import PassivePCA
-from suds_exp.preprocess.tables import prep_fits, prep_versions
+from suds_exp.preprocess.tables import prep_fits, prep_pca, prep_trials, prep_versions
 from suds_exp.robot import sample_columns
 from suds_exp.store import Store
+
+if TYPE_CHECKING:  # the run's result type; the pipeline imports this module
+    from suds_exp.preprocess.pipeline import PrepResult
 
 
 @dataclass
@@ -198,4 +202,148 @@ def get_version(store: Store, ref: int | str | None = None) -> Version:
         k=int(row.k),
         pca=pca,
         phasers=phasers,
+    )
+
+
+# -- writing versions ------------------------------------------------------------------
+@dataclass
+class NewFit:
+    """A fitted state to store in `prep_fits`: kind, group, JSON state, the trial ids it
+    was fitted on and their number of frames."""
+
+    kind: str
+    grp: str
+    state: str
+    trial_ids: list[int]
+    n_frames: int
+
+
+def find_version(conn: sa.Connection, name: str | None, digest: str):
+    """The `prep_versions` row with parameters hash ``digest`` (None if there is none yet);
+    raises `PreprocessError` if ``name`` is already another parameter set's name."""
+    v = prep_versions.c
+    row = conn.execute(sa.select(prep_versions).where(v.params_hash == digest)).first()
+    if name is not None:
+        clash = conn.execute(sa.select(v.id, v.params_hash).where(v.name == name)).first()
+        if clash is not None and clash.params_hash != digest:
+            raise PreprocessError(
+                f"name {name}: version {clash.id} already has that name with other "
+                "parameters; choose another name",
+                param="name",
+            )
+    return row
+
+
+def stored_progress(
+    conn: sa.Connection, version_id: int | None
+) -> tuple[set[int], dict[tuple[str, str], str]]:
+    """What version ``version_id`` already holds: the ids of its preprocessed trials and
+    its fitted states by (kind, group); both empty for a version not yet created (None)."""
+    if version_id is None:
+        return set(), {}
+    done = {
+        int(r[0])
+        for r in conn.execute(
+            sa.select(prep_trials.c.trial_id).where(prep_trials.c.version_id == version_id)
+        )
+    }
+    fits = {
+        (r.kind, r.grp): r.state
+        for r in conn.execute(sa.select(prep_fits).where(prep_fits.c.version_id == version_id))
+    }
+    return done, fits
+
+
+def write_version(
+    store: Store, result: PrepResult, new_fits: list[NewFit], pca, n_kept: int
+) -> None:
+    """Create the version of ``result`` if it is new (setting its id and name) and store
+    its new fits, in one transaction; a new PCA's components go to `prep_pca`, the first
+    ``n_kept`` kept."""
+    with store.write() as conn:
+        if result.version_id < 0:
+            vid = int(conn.exec_driver_sql("SELECT nextval('prep_versions_id_seq')").scalar_one())
+            result.name = result.name or f"v{vid}"
+            conn.execute(
+                sa.insert(prep_versions).values(
+                    id=vid,
+                    name=result.name,
+                    params_hash=result.params_hash,
+                    params=params_json(result.params),
+                    k=result.params["k"],
+                    created_at=sa.func.current_timestamp(),
+                )
+            )
+            result.version_id = vid
+        if new_fits:
+            now = pd.Timestamp.now(tz="UTC").tz_localize(None)
+            rows = [
+                {"version_id": result.version_id, **asdict(f), "fitted_at": now} for f in new_fits
+            ]
+            store.insert_df(conn, prep_fits.name, pd.DataFrame(rows))
+        if any(f.kind == "pca" for f in new_fits):
+            write_pca(store, conn, result.version_id, pca, n_kept)
+
+
+def write_pca(store: Store, conn: sa.Connection, version_id: int, pca, n_kept: int) -> None:
+    """Store a fitted PCA's components (``pca``: a fitted scikit-learn PCA) in
+    `prep_pca` for ``version_id``, the first ``n_kept`` marked as kept."""
+    cum = np.cumsum(pca.explained_variance_ratio_)
+    store.insert_df(
+        conn,
+        prep_pca.name,
+        pd.DataFrame(
+            {
+                "version_id": version_id,
+                "component": np.arange(1, len(cum) + 1),
+                "explained_variance": pca.explained_variance_,
+                "explained_variance_ratio": pca.explained_variance_ratio_,
+                "cumulative_ratio": cum,
+                "kept": np.arange(len(cum)) < n_kept,
+                "loadings": [list(r) for r in pca.components_],
+            }
+        ),
+    )
+
+
+def write_trials(store: Store, result: PrepResult, samples: pd.DataFrame, stats: pd.DataFrame):
+    """Store trials' samples and their `prep_trials` stats in one transaction, then
+    record them in ``result``."""
+    with store.write() as conn:
+        store.insert_df(conn, "samples", samples)
+        store.insert_df(conn, prep_trials.name, stats)
+    result.processed.extend(int(i) for i in stats.trial_id)
+    result.n_samples += len(samples)
+
+
+def kept_ratio(store: Store, version_id: int, k: int) -> list[float]:
+    frame = store.query_df(
+        "SELECT explained_variance_ratio FROM prep_pca WHERE version_id = ? AND kept "
+        "ORDER BY component",
+        [version_id],
+    )
+    if frame.empty:  # a kernel-PCA or autoencoder version: its ratio is in its stored state
+        state = store.query_df(
+            "SELECT state FROM prep_fits WHERE version_id = ? AND kind = 'reducer'", [version_id]
+        )
+        if len(state):
+            return json.loads(state.state.iloc[0])["explained_variance_ratio"][:k]
+    return frame.explained_variance_ratio.tolist()[:k]
+
+
+def list_versions(store: Store) -> pd.DataFrame:
+    """One row per version: id, name, params_hash, k, trials done, samples, created_at,
+    kept explained variance (fraction)."""
+    with store.read() as conn:
+        require_tables(conn)
+    return store.query_df(
+        """
+        SELECT v.id, v.name, v.params_hash, v.k,
+               (SELECT count(*) FROM prep_trials p WHERE p.version_id = v.id) AS n_trials,
+               (SELECT count(*) FROM samples s WHERE s.version_id = v.id) AS n_samples,
+               (SELECT sum(explained_variance_ratio) FROM prep_pca c
+                 WHERE c.version_id = v.id AND c.kept) AS explained_variance_kept,
+               v.created_at, v.params
+        FROM prep_versions v ORDER BY v.id
+        """
     )

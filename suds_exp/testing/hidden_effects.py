@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from suds_exp.discrepancy import DiscrepancyOptions, DiscrepancyResult, run_discrepancy
 from suds_exp.discrepancy.effects import main_parameter
-from suds_exp.discrepancy.workflow import DiscrepancyOptions, DiscrepancyResult, run_discrepancy
 from suds_exp.robot import FREQUENCIES_HZ
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.effects import set_effect
