@@ -616,7 +616,7 @@ def discrepancy(
         open_store(db), start, options, trials, prep, name, out, progress=not (quiet or json_)
     )
     if json_:
-        console.print_json(result.to_json())
+        console.print_json(result.to_dict())
     else:
         print_discrepancy(result)
 
@@ -634,10 +634,11 @@ def demo(
     Simulates the paper's design into a temporary folder, ingests it, preprocesses it,
     runs a small campaign with all five learners and writes its report.
     """
-    from suds_exp.testing.demo import run_demo
+    from suds_exp.console import output_lines
+    from suds_exp.workflows.demo import run_demo
 
     summary = run_demo(
-        open_store(db), out, jobs=jobs, progress=not (quiet or json_), narrate=not json_
+        open_store(db), out, jobs=jobs, progress=not (quiet or json_), say=output_lines(not json_)
     )
     if json_:
         console.print_json(summary.__dict__)

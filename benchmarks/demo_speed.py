@@ -56,7 +56,7 @@ def _simulate(tmp: Path) -> str:
 
 
 def _discrepancy(tmp: Path) -> str:
-    from suds_exp.testing.hidden_effects import demo_discrepancy
+    from suds_exp.workflows.hidden_effects import demo_discrepancy
 
     found = demo_discrepancy(effect="body_inertia", seed=0, out=tmp / "report")
     found.pop("seconds", None)

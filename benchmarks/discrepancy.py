@@ -45,7 +45,7 @@ import numpy as np
 import pandas as pd
 
 from suds_exp.robot import GAITS
-from suds_exp.testing.hidden_effects import HIDDEN, draw_hidden, hidden_effect_run
+from suds_exp.workflows.hidden_effects import HIDDEN, draw_hidden, hidden_effect_run
 
 DESIGN = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
 

@@ -131,7 +131,7 @@ def main() -> None:
         out=args.out / "report",
         progress=True,
     )
-    doc = res.to_json()
+    doc = res.to_dict()
     summary = {
         "named": [(n["candidate"], n["value"], n["ci"], n["gap_closed"]) for n in res.named],
         "gap_before": res.gap_before,

@@ -1,8 +1,7 @@
 """The robot and the experiment, named once: gaits, frequencies, marker roles, samples
 columns, and the parsers of the few strings that name them.
 
-Every other module takes these from here (DESIGN.md, "The robot and its variables" and
-"Names other code relies on"). This module imports nothing of the package but its errors,
+Every other module takes these from here. This module imports nothing of the package but its errors,
 so any box of the data flow may import it.
 
 Gaits, with theta = 2 pi f t + phase0 (rad) and the signed k of `GAIT_K`:

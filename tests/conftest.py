@@ -140,7 +140,7 @@ def inertia_store(work: Path, tau_s: float, seed: int) -> Path:
     """Database of `SMALL_SWEEP` simulated with body inertia ``tau_s`` (s), an effect the
     nominal model lacks; returns its path."""
     from suds_exp.sim.config import SimConfig
-    from suds_exp.testing.hidden_effects import simulate_measured
+    from suds_exp.workflows.hidden_effects import simulate_measured
 
     truth = SimConfig()
     truth.effects.body_inertia.tau_s = tau_s

@@ -23,7 +23,7 @@ from suds_exp.campaign.lock import RunLock
 from suds_exp.errors import StoreError
 from suds_exp.models.registry import LEARNERS
 from suds_exp.store import Store
-from suds_exp.testing.demo_campaign import demo_campaign, demo_options
+from suds_exp.workflows.demo_campaign import demo_campaign, demo_options
 from tests.test_campaign_grid import synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS"], boots=2, train_cycles=4, sweep=[1, 2])

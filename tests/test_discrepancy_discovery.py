@@ -279,7 +279,7 @@ def _withheld(effect: str, seed: int, workdir):
     `benchmarks/discrepancy.py --withheld` runs it at ``seed`` (its design is
     `hidden_effect_run`'s default: 3 gaits x 3 frequencies x 4 repeats, 4-6 cycles)."""
     from suds_exp.discrepancy import DiscrepancyOptions
-    from suds_exp.testing.hidden_effects import draw_hidden, hidden_effect_run
+    from suds_exp.workflows.hidden_effects import draw_hidden, hidden_effect_run
 
     hidden = {effect: draw_hidden(effect, np.random.default_rng(seed))}
     opts = DiscrepancyOptions(seed=seed, exclude=(effect,))

@@ -20,7 +20,7 @@ from suds_exp.discrepancy import candidates_for
 from suds_exp.discrepancy.effects import effect_parameters
 from suds_exp.sim.config import SimConfig
 from suds_exp.store import Store
-from suds_exp.testing.hidden_effects import (
+from suds_exp.workflows.hidden_effects import (
     HIDDEN,
     demo_discrepancy,
     draw_hidden,
@@ -157,7 +157,7 @@ def test_hidden_values_are_drawn_inside_the_realistic_range_away_from_off():
 
 
 def test_hidden_runs_start_from_a_model_without_the_hidden_effect():
-    from suds_exp.testing.hidden_effects import hidden_models
+    from suds_exp.workflows.hidden_effects import hidden_models
 
     truth, start = hidden_models({"spoke_oscillation": {"gain": 2.0}})
     assert truth.effects.spoke_oscillation.gain == 2.0

@@ -22,7 +22,7 @@ runner = CliRunner()
 def test_help_lists_the_commands():
     result = runner.invoke(app, ["--help"])
     assert result.exit_code == 0
-    # DESIGN.md's stable command names
+    # the stable command names
     names = "init ingest trials sql simulate connection effects preprocess run status report"
     for name in (names + " discrepancy demo").split():
         assert f" {name} " in result.stdout, name

@@ -2,7 +2,7 @@
 
 `run_campaign(store, name, CampaignOptions(...))` creates or continues a campaign and
 fills `results`; `campaign_status(store, name)` reports its progress (the small campaign of
-`suds-exp demo` is `suds_exp.testing.demo_campaign`).
+`suds-exp demo` is `suds_exp.workflows.demo_campaign`).
 """
 
 from __future__ import annotations

@@ -44,7 +44,7 @@ def sample_columns(samples: pd.DataFrame) -> list[str]:
     if missing:
         raise CampaignError(
             f"samples frame lacks column(s) {', '.join(missing)}; expected the columns of "
-            "the `samples` table (see DESIGN.md)"
+            "the `samples` table (suds_exp.robot.sample_columns)"
         )
     rp = sorted((c for c in samples.columns if _RP.match(str(c))), key=lambda c: (c[0] == "d", c))
     # r_a beyond the two joint angles (the paper preset's Cartesian values)

@@ -1,12 +1,9 @@
 """The work behind `suds-exp simulate`, `connection` and `effects` (the CLI only parses
 options and prints), plus the parsers of their option strings that the CLI calls.
-
-Simulating then ingesting lives here, above both `suds_exp.sim` and `suds_exp.ingest`,
-which stay independent of each other."""
+Simulating then ingesting is `suds_exp.workflows.simulate`."""
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -16,9 +13,9 @@ from suds_exp.errors import ConfigError
 from suds_exp.robot import FREQUENCIES_HZ, GAITS, parse_frequency
 from suds_exp.sim.config import SimConfig, load_config
 from suds_exp.sim.connection import local_connection, save_connection
-from suds_exp.sim.dataset import simulate_dataset
 from suds_exp.sim.effects import apply_effects, effect_library
 from suds_exp.sim.schedule import split_effects
+from suds_exp.workflows.simulate import simulate_and_ingest
 
 
 def parse_gaits(text: str | None) -> tuple[str, ...]:
@@ -111,33 +108,28 @@ def simulate_command(
             f"gaits {list(gaits)!r}: expected some of {', '.join(GAITS)}", param="gaits"
         )
     cycles = check_cycles(tuple(cycles))
-    start = time.perf_counter()
-    ds = simulate_dataset(
+    run = simulate_and_ingest(
+        store,
         out,
-        config or SimConfig(),
-        gaits=tuple(gaits),
-        frequencies_hz=tuple(float(f) for f in frequencies_hz),
+        config,
+        gaits=gaits,
+        frequencies_hz=frequencies_hz,
         repeats=repeats,
         cycles=cycles,
         seed=seed,
+        changes=changes,
         progress=progress,
-        changes=list(changes),
     )
-    wall = time.perf_counter() - start
+    ds = run.dataset
     summary = {
         "out": str(out),
         "manifest": str(ds.manifest),
         "files": [str(p) for p in ds.tsv_paths],
         "n_trials": len(ds.tsv_paths),
         "simulated_seconds": round(float(ds.simulated_seconds), 3),
-        "wall_seconds": round(wall, 3),
-        "trial_ids": None,
+        "wall_seconds": round(run.wall_seconds, 3),
+        "trial_ids": [r.trial_id for r in run.ingested] if store is not None else None,
     }
-    if store is not None:
-        from suds_exp.ingest import ingest_paths
-
-        results = ingest_paths(store, [], manifest=ds.manifest, progress=False)
-        summary["trial_ids"] = [r.trial_id for r in results]
     return summary
 
 

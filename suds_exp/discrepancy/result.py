@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -106,7 +107,8 @@ class DiscrepancyResult:
         d = self.discovery
         return float(np.mean(d.test_after)) if d is not None and d.significant else self.gap_after
 
-    def to_json(self) -> dict:
+    def to_dict(self) -> dict:
+        """The run as plain data (JSON-ready), as every result object of the package gives it."""
         last = self.steps[-1]
         return {
             "run_id": self.run_id,
@@ -157,6 +159,15 @@ class DiscrepancyResult:
             "train_trials": self.train_trials,
             "test_trials": self.test_trials,
         }
+
+    def to_json(self) -> dict:
+        """Deprecated spelling of `to_dict` (kept for one release)."""
+        warnings.warn(
+            "DiscrepancyResult.to_json() is deprecated; use to_dict()",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.to_dict()
 
 
 def discovery_json(d: Discovery | None) -> dict | None:

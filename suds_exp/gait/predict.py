@@ -277,7 +277,7 @@ class GaitPrediction:
 
 #: Fewest refits a 95 % percentile interval is given from: the 2.5 and 97.5 percentiles
 #: of B refits need at least one refit beyond each (B x 2.5 % >= 1). With 3 refits the
-#: "interval" is the range of 3 numbers, and the full fit fell outside it (issue 39).
+#: "interval" is the range of 3 numbers, and the full fit can fall outside it.
 MIN_BOOT = 40
 
 

@@ -1,6 +1,6 @@
 """What every learner shares: reading a samples frame, trials as time series, checks.
 
-A samples frame has the columns of the `samples` table (see DESIGN.md): `trial_id`,
+A samples frame has the columns of the `samples` table (`robot.sample_columns`): `trial_id`,
 `t` (s), `phase` (rad, unwrapped), `ra_1..ra_m`, `dra_1..dra_m` (m = 2 joint angles,
 rad and rad/s, or the paper preset's Cartesian values, mm and mm/s), `rp_1..rp_k`,
 `drp_1..drp_k`, `vx`, `vy` (mm/s), `wz` (rad/s), all in the body frame.

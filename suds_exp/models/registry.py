@@ -1,6 +1,6 @@
 """Every named learner, once: its name, family, whether it uses SUDS, and its tags.
 
-The one home of learner names (issue 29, "one home per fact"): the paper's five
+The one home of learner names ("one home per fact"): the paper's five
 (`LEARNERS`), the survey's set (`SURVEY_LEARNERS`), the online learners and the
 scikit-learn baselines are read from `REGISTRY`, and so are the roles other modules give
 a learner (`PHASE_ONLY`, `TLS`, ... below). The SQL vocabulary table ``learners``

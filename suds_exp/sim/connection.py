@@ -79,7 +79,7 @@ class Connection:
     max_residual: float
 
     def to_frame(self) -> pd.DataFrame:
-        """The CSV layout of DESIGN.md, one row per grid point (phi2 fastest)."""
+        """The CSV layout of `suds-exp connection`, one row per grid point (phi2 fastest)."""
         p1, p2 = np.meshgrid(self.phi1, self.phi2, indexing="ij")
         cols = {"phi1": p1.ravel(), "phi2": p2.ravel()}
         for c, comp in enumerate(("vx", "vy", "wz")):

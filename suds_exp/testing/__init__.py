@@ -1,11 +1,11 @@
-"""Data with a known truth and the demo built on it, for tests, benchmarks and `suds-exp demo`.
+"""Data with a known truth, for tests, benchmarks and the docs.
 
 - `synthetic_captures`: marker captures of a rigid 3-segment robot with known kinematics;
 - `synthetic_swimmer`: samples frames of a swimmer with a known motility map;
 - `synthetic_results`: `results` rows with planted effects of known size;
-- `hidden_effects`: simulated "measured" data with effects hidden from the discrepancy
-  workflow;
-- `demo_campaign`, `demo`: the small campaign and the whole pipeline of `suds-exp demo`.
+- `kinematic_body`: planar bodies of rigid segments (random joint trees) and their captures.
 
-Nothing here is imported by the library below it.
+It sits just above what it fakes (bodies, captures, learners' results) and below the
+analyses that read such data; the pipelines built on it (the demo, the hidden-effect
+runs) are `suds_exp.workflows`. Nothing here is imported by the library below it.
 """

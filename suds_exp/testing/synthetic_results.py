@@ -14,7 +14,6 @@ import json
 import numpy as np
 import pandas as pd
 
-from suds_exp.analysis.categories import GAIT_AXIS
 from suds_exp.models.registry import (
     GMR,
     GMR_SUDS,
@@ -24,7 +23,7 @@ from suds_exp.models.registry import (
     TLS,
     TLS_SUDS,
 )
-from suds_exp.robot import FREQUENCIES_HZ
+from suds_exp.robot import FREQUENCIES_HZ, GAITS
 
 #: The paper's first-order-interactions GLM (its Table "GLM coefficient comparison"), used
 #: as the default truth so a synthetic report can be read beside the paper's.
@@ -133,7 +132,7 @@ def synthetic_results(
 def _job_grid(models, n_cycles, n_boot: int) -> pd.DataFrame:
     """One row per (model, train condition, test condition, n_cycles, boot), with the
     gait-axis distance between train and test gaits in ``_steps``."""
-    conditions = [(g, round(f, 6)) for g in GAIT_AXIS for f in FREQUENCIES_HZ]
+    conditions = [(g, round(f, 6)) for g in GAITS for f in FREQUENCIES_HZ]
     grid = pd.DataFrame(
         [
             (m, tg, tf, dg, df, n, b)
@@ -151,7 +150,7 @@ def _job_grid(models, n_cycles, n_boot: int) -> pd.DataFrame:
             "boot",
         ],
     )
-    pos = {g: i for i, g in enumerate(GAIT_AXIS)}
+    pos = {g: i for i, g in enumerate(GAITS)}
     grid["_steps"] = np.abs(grid["train_gait"].map(pos) - grid["test_gait"].map(pos))
     return grid
 

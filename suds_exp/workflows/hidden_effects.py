@@ -84,16 +84,21 @@ def simulate_measured(
     cycles: tuple[int, int],
 ):
     """Simulate a dataset into ``workdir``, ingest and preprocess it; return the store."""
-    from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
-    from suds_exp.sim.dataset import simulate_dataset
     from suds_exp.store import Store
+    from suds_exp.workflows.simulate import simulate_and_ingest
 
-    ds = simulate_dataset(
-        workdir / "data", config, gaits, frequencies_hz, repeats, cycles, seed=seed
-    )
     store = Store(workdir / "suds.duckdb")
-    ingest_paths(store, [workdir / "data"], ds.manifest, None, progress=False)
+    simulate_and_ingest(
+        store,
+        workdir / "data",
+        config,
+        gaits=gaits,
+        frequencies_hz=frequencies_hz,
+        repeats=repeats,
+        cycles=cycles,
+        seed=seed,
+    )
     preprocess(store, "v1", progress=False)
     return store
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from suds_exp.console import output_lines
 from suds_exp.errors import IngestError
 from suds_exp.store import Store
 
@@ -50,23 +50,23 @@ def run_demo(
     seed: int = 0,
     hidden_effect: str = "body_inertia",
     progress: bool = True,
-    narrate: bool = True,
+    say: Callable[[str], None] | None = None,
 ) -> DemoSummary:
     """Run the demo end to end into ``store``; returns a `DemoSummary`.
 
     ``report_dir / campaign`` receives the campaign report and
     ``report_dir / "discrepancy-demo"`` the discrepancy report of ``hidden_effect``
     hidden in new simulated data. ``progress``: bars and stage lines on stderr;
-    ``narrate``: one line per finished step on stdout (the demo's output, as
-    `suds_exp.console.output_lines`).
+    ``say``: called with one line of text per finished step (the demo's narration;
+    the command prints it), None: silent.
     """
     from suds_exp.analysis import write_report
-    from suds_exp.testing.demo_campaign import demo_campaign
+    from suds_exp.workflows.demo_campaign import demo_campaign
 
-    say = output_lines(narrate)
+    say = say or (lambda _line: None)
     summary = DemoSummary(campaign=campaign)
     lap = _Clock(summary).lap
-    simulate_and_ingest(store, summary, seed, progress, say, lap)
+    simulate_step(store, summary, seed, progress, say, lap)
     prep_name = preprocess_step(store, summary, progress, say, lap)
     run = demo_campaign(store, campaign, prep=prep_name, jobs=jobs, progress=progress)
     summary.n_results = run.done_before + run.done_now
@@ -94,20 +94,13 @@ class _Clock:
         return self.summary.seconds[step]
 
 
-def simulate_and_ingest(store: Store, summary: DemoSummary, seed: int, progress, say, lap):
+def simulate_step(store: Store, summary: DemoSummary, seed: int, progress, say, lap):
     """Simulate the paper's design into a temporary folder and ingest it."""
-    from suds_exp.ingest import ingest_paths
-    from suds_exp.sim import simulate_dataset
+    from suds_exp.workflows.simulate import simulate_and_ingest
 
     with tempfile.TemporaryDirectory(prefix="suds-demo-") as tmp:
-        data = simulate_dataset(tmp, seed=seed, progress=progress)
-        summary.simulated_seconds = data.simulated_seconds
-        say(
-            f"simulated {len(data.tsv_paths)} trials ({data.simulated_seconds / 60:.0f} min of "
-            f"robot time) in {lap('simulate'):.0f} s"
-        )
         try:
-            results = ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=progress)
+            run = simulate_and_ingest(store, tmp, seed=seed, progress=progress)
         except IngestError as exc:
             # e.g. a database holding another dataset (or an older simulator's) at the
             # same conditions: never overwrite it, say how to run the demo anyway.
@@ -115,10 +108,20 @@ def simulate_and_ingest(store: Store, summary: DemoSummary, seed: int, progress,
                 f"{exc} -- the demo's simulated trials clash with trials already in "
                 f"{store.path}; run the demo on a database of its own, e.g. demo.duckdb"
             ) from None
-        summary.n_trials = len(results)
-        fresh = sum(r.status == "ingested" for r in results)
-        stored = len(results) - fresh
-        say(f"ingested {fresh} new trials ({stored} already stored) in {lap('ingest'):.0f} s")
+    data = run.dataset
+    summary.simulated_seconds = data.simulated_seconds
+    summary.n_trials = len(run.ingested)
+    both = lap("ingest")
+    summary.seconds["simulate"] = run.wall_seconds
+    summary.seconds["ingest"] = both - run.wall_seconds
+    say(
+        f"simulated {len(data.tsv_paths)} trials ({data.simulated_seconds / 60:.0f} min of "
+        f"robot time) in {run.wall_seconds:.0f} s"
+    )
+    say(
+        f"ingested {run.n_new} new trials ({summary.n_trials - run.n_new} already stored) "
+        f"in {summary.seconds['ingest']:.0f} s"
+    )
 
 
 def preprocess_step(store: Store, summary: DemoSummary, progress, say, lap) -> str:
@@ -170,7 +173,7 @@ def findings_step(store: Store, summary: DemoSummary, say, lap) -> None:
 
 def discrepancy_step(summary: DemoSummary, out: Path, hidden_effect: str, seed: int, say, lap):
     """Hide ``hidden_effect`` in new simulated data and let the workflow name it."""
-    from suds_exp.testing.hidden_effects import demo_discrepancy
+    from suds_exp.workflows.hidden_effects import demo_discrepancy
 
     # The hidden-effect data lives in its own temporary database: it re-uses the
     # conditions of the demo's data with different content, which ingest would refuse.
