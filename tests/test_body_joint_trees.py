@@ -28,7 +28,7 @@ from suds_exp.testing.kinematic_body import (
     sine,
     write_body_trial,
 )
-from tests.conftest import assert_same_db, dump_db
+from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 

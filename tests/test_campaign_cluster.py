@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 import cli
 from suds_exp.store import Store
-from tests.test_campaign_runner import results
+from tests.helpers import campaign_rows
 
 pytestmark = pytest.mark.slow
 
@@ -77,7 +77,7 @@ def test_a_killed_worker_and_a_killed_scheduler_lose_nothing(tmp_path, version_d
     shutil.copy(version_db, local)
     out = CliRunner().invoke(cli.app, [*RUN, "--db", str(local)])
     assert out.exit_code == 0, out.output
-    expected = results(Store(local))
+    expected = campaign_rows(Store(local))
 
     db = tmp_path / "cluster.duckdb"
     shutil.copy(version_db, db)
@@ -111,4 +111,4 @@ def test_a_killed_worker_and_a_killed_scheduler_lose_nothing(tmp_path, version_d
     finally:
         _kill(scheduler, *workers)
     assert again.returncode == 0, again.stderr
-    pd.testing.assert_frame_equal(results(Store(db)), expected, check_exact=True)
+    pd.testing.assert_frame_equal(campaign_rows(Store(db)), expected, check_exact=True)

@@ -16,8 +16,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.models import TLS, make_model
 from suds_exp.robot import VB_COLUMNS
 from suds_exp.store import Store
-from tests.test_campaign_grid import synthetic_samples
-from tests.test_campaign_runner import results
+from tests.helpers import campaign_rows, synthetic_samples
 
 
 @pytest.fixture(scope="module")
@@ -117,4 +116,4 @@ def test_a_run_stopped_inside_a_chunk_resumes_with_every_row_once(tmp_path, monk
 
     again = run_campaign(store, "c", samples=samples, progress=False)
     assert again.done_before == 6 and again.done_now == again.total_jobs - 6
-    pd.testing.assert_frame_equal(results(store), results(full), check_exact=True)
+    pd.testing.assert_frame_equal(campaign_rows(store), campaign_rows(full), check_exact=True)

@@ -7,8 +7,7 @@ import pytest
 
 from suds_exp.campaign import CampaignOptions, run_campaign
 from suds_exp.store import Store
-from tests.test_campaign_grid import synthetic_samples
-from tests.test_campaign_runner import results
+from tests.helpers import campaign_rows, synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS+SUDS"], boots=2, train_cycles=3, sweep=[1])
 N_JOBS = (9 * 2 + 3 * 2) * 2
@@ -23,7 +22,7 @@ def samples() -> pd.DataFrame:
 def reference(tmp_path_factory, samples) -> pd.DataFrame:
     one = Store(tmp_path_factory.mktemp("one") / "one.duckdb")
     run_campaign(one, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
-    frame = results(one)
+    frame = campaign_rows(one)
     assert len(frame) == N_JOBS
     return frame
 
@@ -34,7 +33,7 @@ def run_on(tmp_path, samples, **kw) -> pd.DataFrame:
         store, "c", CampaignOptions(**OPTIONS), samples=samples, chunk_jobs=3, progress=False, **kw
     )
     assert summary.done_now == N_JOBS
-    return results(store)
+    return campaign_rows(store)
 
 
 def test_two_loky_workers_give_the_rows_of_one(tmp_path, samples, reference):

@@ -13,7 +13,6 @@ from typer.testing import CliRunner
 import cli
 from suds_exp.campaign import (
     KEY_COLUMNS,
-    TIMING_COLUMNS,
     CampaignError,
     CampaignOptions,
     campaign_status,
@@ -24,7 +23,7 @@ from suds_exp.errors import StoreError
 from suds_exp.models.registry import LEARNERS
 from suds_exp.store import Store
 from suds_exp.workflows.demo_campaign import demo_campaign, demo_options
-from tests.test_campaign_grid import synthetic_samples
+from tests.helpers import campaign_rows, synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS"], boots=2, train_cycles=4, sweep=[1, 2])
 
@@ -34,20 +33,13 @@ def samples() -> pd.DataFrame:
     return synthetic_samples()
 
 
-def results(store: Store, campaign: str = "c") -> pd.DataFrame:
-    frame = store.query_df("SELECT * FROM results WHERE campaign = ? ORDER BY ALL", [campaign])
-    return frame.drop(columns=list(TIMING_COLUMNS)).sort_values(
-        list(KEY_COLUMNS), ignore_index=True
-    )
-
-
 def test_a_campaign_fills_one_row_per_job(db, samples):
     store = Store(db)
     summary = run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     # 4 conditions: 16 pairs x 2 boots + 4 same-condition pairs x 2 boots x 2 sweep values
     assert summary.total_jobs == (16 * 2 + 4 * 2 * 2) * 2
     assert summary.done_now == summary.total_jobs and summary.failed_now == 0
-    frame = results(store)
+    frame = campaign_rows(store)
     assert len(frame) == summary.total_jobs
     assert not frame.duplicated(list(KEY_COLUMNS)).any()
     assert frame.error.isna().all() and (frame.rmse_vx > 0).all()
@@ -82,10 +74,10 @@ def test_resume_skips_finished_jobs_and_reproduces_the_rest(db, tmp_path, sample
     run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     with store.write() as conn:
         conn.exec_driver_sql("DELETE FROM results WHERE boot = 1 OR model = 'TLS' AND n_cycles = 1")
-    kept = len(results(store))
+    kept = len(campaign_rows(store))
     again = run_campaign(store, "c", CampaignOptions(), samples=samples, progress=False)
     assert again.done_before == kept and again.done_now == again.total_jobs - kept
-    pd.testing.assert_frame_equal(results(store), results(full), check_exact=True)
+    pd.testing.assert_frame_equal(campaign_rows(store), campaign_rows(full), check_exact=True)
     nothing = run_campaign(store, "c", samples=samples, progress=False)
     assert nothing.done_now == 0 and "already done" in nothing.message()
 
@@ -93,7 +85,7 @@ def test_resume_skips_finished_jobs_and_reproduces_the_rest(db, tmp_path, sample
 def test_continuing_with_changed_options_is_refused_naming_the_differences(db, samples):
     store = Store(db)
     run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
-    before = results(store)
+    before = campaign_rows(store)
     with pytest.raises(CampaignError, match=r"boots: 2 -> 3"):
         run_campaign(store, "c", CampaignOptions(boots=3), samples=samples, progress=False)
     with pytest.raises(CampaignError, match=r"models\.TLS\.n_bins"):
@@ -102,7 +94,7 @@ def test_continuing_with_changed_options_is_refused_naming_the_differences(db, s
     with pytest.raises(CampaignError, match=r"trials"):
         fewer = samples[samples.trial_id != 3]
         run_campaign(store, "c", samples=fewer, progress=False)
-    pd.testing.assert_frame_equal(results(store), before)
+    pd.testing.assert_frame_equal(campaign_rows(store), before)
 
 
 def test_a_second_run_on_the_same_database_is_refused(db, samples):

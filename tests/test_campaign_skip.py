@@ -13,8 +13,7 @@ import cli
 from suds_exp.campaign import CampaignError, CampaignOptions, SampleBank, run_campaign
 from suds_exp.campaign.status import campaign_status
 from suds_exp.store import Store
-from tests.conftest import assert_same_db, dump_db
-from tests.test_campaign_grid import synthetic_samples
+from tests.helpers import assert_same_db, dump_db, synthetic_samples
 
 SHORT = ("D+", 0.5)
 

@@ -20,7 +20,7 @@ from typer.testing import CliRunner
 from cli import app
 from suds_exp.discrepancy.effects import effect_names
 from suds_exp.store import Store
-from tests.conftest import discrepancy_json, inertia_store
+from tests.helpers import discrepancy_json, inertia_store
 
 runner = CliRunner()
 

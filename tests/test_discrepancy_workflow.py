@@ -26,7 +26,7 @@ from suds_exp.workflows.hidden_effects import (
     draw_hidden,
     hidden_effect_run,
 )
-from tests.conftest import SMALL_SWEEP, discrepancy_json, inertia_store
+from tests.helpers import SMALL_SWEEP, discrepancy_json, inertia_store
 
 runner = CliRunner()
 TAU = 0.2

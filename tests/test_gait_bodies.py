@@ -20,7 +20,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.gait.predict import MIN_BOOT, percentile_interval
 from suds_exp.gait.shape import FourierGait, read_gait_file
 from suds_exp.testing.kinematic_body import serial_body, write_body_trial
-from tests.conftest import assert_same_db, dump_db
+from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 

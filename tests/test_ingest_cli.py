@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from tests.conftest import assert_same_db, dump_db, qtm_text, random_track
+from tests.helpers import assert_same_db, dump_db, qtm_text, random_track
 
 runner = CliRunner()
 

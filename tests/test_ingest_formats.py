@@ -2,34 +2,12 @@
 
 from __future__ import annotations
 
-import io
-import warnings
-
-import c3d
 import numpy as np
 import pytest
 
 from suds_exp.ingest import read_capture
 from suds_exp.ingest.csv_reader import write_marker_csv
-from tests.conftest import qtm_text, random_track
-
-
-def write_c3d(path, names, xyz, rate=100.0, units="mm  ", scale=1.0):
-    writer = c3d.Writer(point_rate=rate, point_units=units)
-    writer.set_point_labels(names)
-    frames = []
-    for frame in xyz:
-        points = np.zeros((len(names), 5), np.float32)
-        points[:, :3] = np.nan_to_num(frame / scale)
-        points[:, 3] = np.where(np.isnan(frame).any(axis=1), -1.0, 0.0)
-        frames.append((points, np.zeros((0, 0), np.float32)))
-    writer.add_frames(frames)
-    buffer = io.BytesIO()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        writer.write(buffer)
-    path.write_bytes(buffer.getvalue())
-    return path
+from tests.helpers import qtm_text, random_track, write_c3d, write_motive, write_trc, write_vicon
 
 
 @pytest.fixture
@@ -54,70 +32,6 @@ def test_csv_round_trip(tmp_path, data):
     assert csv_capture.sample_rate_hz == pytest.approx(100.0)
     assert csv_capture.marker_names == names
     np.testing.assert_allclose(csv_capture.xyz, qtm.xyz, atol=1e-3, equal_nan=True)
-
-
-def _cells(frame, scale=1.0):
-    return ["" if np.isnan(v) else f"{v / scale:.6f}" for v in frame.reshape(-1)]
-
-
-def write_trc(path, names, xyz, rate=100.0, units="mm", scale=1.0, first=1):
-    """A TRC file laid out as OpenSim documents it (a blank line before the frames)."""
-    n = len(names)
-    head = [
-        f"PathFileType\t4\t(X/Y/Z)\t{path.name}",
-        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t"
-        "OrigDataStartFrame\tOrigNumFrames",
-        f"{rate:g}\t{rate:g}\t{len(xyz)}\t{n}\t{units}\t{rate:g}\t{first}\t{len(xyz)}",
-        "Frame#\tTime\t" + "\t\t\t".join(names),
-        "\t\t" + "\t".join(f"{a}{i}" for i in range(1, n + 1) for a in "XYZ"),
-        "",
-    ]
-    rows = [
-        "\t".join([str(first + i), f"{i / rate:.5f}"] + _cells(frame, scale))
-        for i, frame in enumerate(xyz)
-    ]
-    path.write_text("\n".join(head + rows) + "\n")
-    return path
-
-
-def write_vicon(path, names, xyz, rate=100.0, units="mm", scale=1.0, first=5):
-    """A Nexus CSV: a Devices block, then Trajectories with subject-prefixed names."""
-    n = len(names)
-    devices = ["Devices", f"{rate * 10:g}", ",,Plate", "Frame,Sub Frame,Fx", ",,N", "5,0,1.5", ""]
-    head = [
-        "Trajectories",
-        f"{rate:g}",
-        ",," + ",".join(f"Robot:{m},," for m in names),
-        "Frame,Sub Frame," + ",".join(["X,Y,Z"] * n),
-        ",," + ",".join([units] * 3 * n),
-    ]
-    rows = [",".join([str(first + i), "0"] + _cells(f, scale)) for i, f in enumerate(xyz)]
-    path.write_text("\r\n".join(devices + head + rows) + "\r\n\r\n")
-    return path
-
-
-def write_motive(path, names, xyz, rate=100.0):
-    """A Motive 1.23 CSV in metres with a rigid body's columns before the markers."""
-    n = len(names)
-    head = [
-        f"Format Version,1.23,Take Name,t,Capture Frame Rate,{rate:f},Export Frame Rate,"
-        f"{rate:f},Total Exported Frames,{len(xyz)},Rotation Type,Quaternion,"
-        "Length Units,Meters,Coordinate Space,Global",
-        "",
-        ",Type," + ",".join(["Rigid Body"] * 7 + ["Marker"] * 3 * n),
-        ",Name," + ",".join(["RB"] * 7 + [f"Sub:{m}" for m in names for _ in "XYZ"]),
-        ",ID," + ",".join(["1"] * 7 + [f'"{j}"' for j in range(n) for _ in "XYZ"]),
-        ",," + ",".join(["Rotation"] * 4 + ["Position"] * (3 + 3 * n)),
-        "Frame,Time (Seconds)," + ",".join(["X,Y,Z,W", "X,Y,Z"] + ["X,Y,Z"] * n),
-    ]
-    rows = [
-        ",".join([str(i), f"{i / rate:.6f}"] + ["0", "0", "0", "1", "1", "2", "3"])
-        + ","
-        + ",".join(_cells(f, 1000.0))
-        for i, f in enumerate(xyz)
-    ]
-    path.write_text("\n".join(head + rows) + "\n")
-    return path
 
 
 @pytest.mark.parametrize(

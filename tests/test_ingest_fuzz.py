@@ -12,8 +12,7 @@ from hypothesis import strategies as st
 from suds_exp.errors import IngestError
 from suds_exp.ingest import read_capture
 from suds_exp.ingest.csv_reader import write_marker_csv
-from tests.conftest import qtm_text, random_track
-from tests.test_ingest_formats import write_c3d, write_motive, write_trc, write_vicon
+from tests.helpers import qtm_text, random_track, write_c3d, write_motive, write_trc, write_vicon
 
 FUZZ = settings(max_examples=120, deadline=None, suppress_health_check=list(HealthCheck))
 

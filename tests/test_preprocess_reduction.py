@@ -13,8 +13,7 @@ from suds_exp.preprocess import get_version
 from suds_exp.preprocess.reduction import AutoencoderReducer, KernelPCAReducer
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.store import Store
-from tests.conftest import assert_same_db, dump_db
-from tests.test_preprocess_versions import cli, dataset, ingested, sql  # noqa: F401
+from tests.helpers import assert_same_db, cli, dump_db, sql
 
 
 def passive_loop(n=600, seed=0):

@@ -4,53 +4,17 @@ parameter = a new one beside it, resumable runs, refused trials leave the DB unc
 from __future__ import annotations
 
 import json
-import shutil
-from pathlib import Path
 
 import duckdb
 import numpy as np
 import pandas as pd
 import pytest
-from typer.testing import CliRunner
 
-from cli import app
 from suds_exp.ingest import ingest_paths
 from suds_exp.preprocess import PreprocessError, load_samples, pipeline, preprocess, sample_columns
 from suds_exp.store import Store
-from suds_exp.testing.synthetic_captures import synthetic_trial, write_dataset, write_marker_csv
-from tests.conftest import assert_same_db, dump_db
-
-runner = CliRunner()
-
-
-def cli(*args):
-    return runner.invoke(app, [str(a) for a in args])
-
-
-def sql(db, query):
-    out = cli("sql", query, "--db", db, "--json")
-    assert out.exit_code == 0, out.output
-    return json.loads(out.stdout)
-
-
-@pytest.fixture(scope="module")
-def ingested(tmp_path_factory) -> Path:
-    """Five synthetic trials (one per gait, 0.5 Hz, 4 cycles) ingested into a database."""
-    folder = tmp_path_factory.mktemp("prep")
-    manifest = write_dataset(
-        folder / "data", frequencies=(0.5,), n_cycles=4, n_jumps=3, n_dropouts=3
-    )
-    db = folder / "template.duckdb"
-    ingest_paths(Store(db), [], manifest, progress=False)
-    return db
-
-
-@pytest.fixture
-def dataset(ingested: Path, tmp_path: Path) -> Path:
-    """A fresh copy of the ingested database for one test."""
-    db = tmp_path / "db.duckdb"
-    shutil.copyfile(ingested, db)
-    return db
+from suds_exp.testing.synthetic_captures import synthetic_trial, write_marker_csv
+from tests.helpers import assert_same_db, cli, dump_db, sql
 
 
 def test_same_parameters_make_one_version_and_rerun_skips(dataset):

@@ -1,9 +1,10 @@
-"""Every writing path keeps the promise (issue 33): one writer at a time, a damaged file
+"""Every writing path keeps the promise: one writer at a time, a damaged file
 refused, file-system errors and refusals in one line with the database byte-identical,
 Ctrl-C and kill -9 ending a campaign and its workers cleanly.
 
-The probe itself lives in `benchmarks/reliability.py` (it prints the counts of the long
-version); these tests run a few of its cases, the long ones marked slow.
+The probe itself is `tests/reliability_probe.py` (`python -m tests.reliability_probe`
+prints the counts of the long version); these tests run a few of its cases, the long ones
+marked slow.
 """
 
 from __future__ import annotations
@@ -21,11 +22,11 @@ import pytest
 from typer.testing import CliRunner
 
 import cli
-from benchmarks import reliability as probe
 from suds_exp.errors import StoreError
 from suds_exp.store import Store
 from suds_exp.store import lock as write_lock
 from suds_exp.store.engine import lock_holder
+from tests import reliability_probe as probe
 
 runner = CliRunner()
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tests.conftest import SLOW_FILES
+from tests.helpers import SLOW_FILES
 
 
 def test_every_slow_file_named_for_the_schedule_exists():

@@ -19,8 +19,8 @@ of 12 cycles) and counts:
   unwritable report and plot folders: one line, status 2, the database file byte-identical;
 - the cost of the integrity check on a large file.
 
-    python benchmarks/reliability.py            # the long version (~15 min on 2 cores)
-    python benchmarks/reliability.py --quick    # one moment / offset each (~4 min)
+    python -m tests.reliability_probe            # the long version (~15 min on 2 cores)
+    python -m tests.reliability_probe --quick    # one moment / offset each (~4 min)
 """
 
 from __future__ import annotations
@@ -41,12 +41,10 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
+import duckdb
+import pandas as pd
 
-import duckdb  # noqa: E402
-import pandas as pd  # noqa: E402
+REPO = Path(__file__).resolve().parents[1]
 
 CLI = [sys.executable, str(REPO / "cli.py")]
 #: Columns that differ between two runs of the same work (clock, pid, timing).
