@@ -11,7 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from suds_exp.analysis.findings import PASSIVE_COLUMNS, passive_information
+from suds_exp.analysis.passive import PASSIVE_COLUMNS, passive_information
 from suds_exp.store import Store
 from suds_exp.testing.synthetic_results import synthetic_results
 

@@ -16,15 +16,7 @@ import pandas as pd
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
 from suds_exp.analysis.design_report import skipped_html, write_design_report
-from suds_exp.analysis.findings import (
-    PASSIVE_EXPLANATION,
-    campaign_passive_information,
-    findings_display,
-    findings_headline,
-    findings_table,
-    passive_display,
-    passive_reason,
-)
+from suds_exp.analysis.findings import findings_display, findings_headline, findings_table
 from suds_exp.analysis.formatting import (
     ReportTables,
     not_computed_html,
@@ -35,6 +27,12 @@ from suds_exp.analysis.formatting import (
 )
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
+from suds_exp.analysis.passive import (
+    PASSIVE_EXPLANATION,
+    campaign_passive_information,
+    passive_display,
+    passive_reason,
+)
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.spread import PAIRS, iqr_table, slope_table
 from suds_exp.errors import AnalysisError

@@ -5,13 +5,10 @@ from __future__ import annotations
 import pandas as pd
 
 from suds_exp import console
-from suds_exp.analysis.findings import (
+from suds_exp.analysis.findings import findings, findings_display, findings_headline, findings_json
+from suds_exp.analysis.passive import (
     PASSIVE_EXPLANATION,
     campaign_passive_information,
-    findings,
-    findings_display,
-    findings_headline,
-    findings_json,
     passive_display,
     passive_reason,
 )

@@ -157,7 +157,7 @@ def findings_step(store: Store, summary: DemoSummary, say, lap) -> None:
     display = findings_display(table)
     say(display.to_string(index=False, max_colwidth=60))
     say(f"{summary.findings_headline} ({lap('findings'):.0f} s)")
-    from suds_exp.analysis.findings import (
+    from suds_exp.analysis.passive import (
         PASSIVE_EXPLANATION,
         campaign_passive_information,
         passive_display,
