@@ -28,7 +28,7 @@ GMR_VARIANTS = [
     ("GMR", {"select_k": "bic", "k_candidates": (4, 8)}),
 ]
 
-#: The survey's scikit-learn baselines (suds_exp/models/sklearn_adapter.py).
+#: The survey's scikit-learn baselines (suds_exp/models/baselines.py).
 SURVEY = [
     ("MLP", {"random_state": 0}),
     ("MLP+SUDS", {"random_state": 0}),

@@ -28,7 +28,7 @@ Sections:
    different trial of O at 1/2 Hz (same), O at 1 Hz and O at 1/3 Hz (other speed), and
    D+ at 1/2 Hz (other gait).
 4. Solver of the MLP baselines (why it is L-BFGS): for the MLP and MLP+SUDS networks of
-   `sklearn_adapter.BASELINES` on 30 training cycles, seeds 0 and 1, the held-out RMSE
+   `baselines.BASELINES` on 30 training cycles, seeds 0 and 1, the held-out RMSE
    of vx (a different 20-cycle trial of O at 1/2 Hz) and the R^2 on a 10 % validation
    split after 5 ... 200 epochs of Adam (lr 1e-3, the former default), then the same
    held-out RMSE and the fit CPU seconds of the default, L-BFGS with at most 100 and

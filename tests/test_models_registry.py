@@ -6,6 +6,7 @@ import pytest
 
 from suds_exp.commands.campaign import parse_campaign_options
 from suds_exp.models import BASELINE_NAMES, MODEL_NAMES, ONLINE_MODELS, make_model
+from suds_exp.models.baselines import BASELINES
 from suds_exp.models.registry import (
     LEARNERS,
     REGISTRY,
@@ -13,7 +14,6 @@ from suds_exp.models.registry import (
     SURVEY_LEARNERS,
     tagged,
 )
-from suds_exp.models.sklearn_adapter import BASELINES
 
 
 def test_the_paper_five_in_its_order():

@@ -14,9 +14,10 @@ Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(s
 `OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
 `GradualGMR+SUDS` (`gradual.GradualGMRSuds`: GMR that adds passive coordinates online).
 
-Beyond the paper (`sklearn_adapter.py`): `MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each
-also `+SUDS`) and `sklearn:ClassName` / `sklearn:pkg.mod.Class` (any regressor, `+SUDS`
-for GMR+SUDS's inputs); `model_recipe(model)` is what a campaign stores to rebuild one.
+Beyond the paper (`sklearn_adapter.py`; names and recipes in `sklearn_recipes.py`):
+`MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each also `+SUDS`) and `sklearn:ClassName` /
+`sklearn:pkg.mod.Class` (any regressor, `+SUDS` for GMR+SUDS's inputs);
+`model_recipe(model)` is what a campaign stores to rebuild one.
 
 Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 `predict(samples) -> DataFrame[vx, vy, wz(, drp_1..drp_k)]` with the input's index.
@@ -33,7 +34,8 @@ from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
 from suds_exp.models.registry import BASELINE_LEARNERS, LEARNERS, ONLINE_LEARNERS
-from suds_exp.models.sklearn_adapter import SklearnLearner, make_adapter, recipe
+from suds_exp.models.sklearn_adapter import SklearnLearner
+from suds_exp.models.sklearn_recipes import make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
 
 #: The paper's five by name (`registry.LEARNERS`, in its order).
@@ -53,7 +55,7 @@ def make_model(name: str, **params) -> Learner:
     """A new, unfitted learner by name (see MODEL_NAMES) with the given hyper-parameters.
 
     Also the baselines (BASELINE_NAMES) and `sklearn:ClassName[+SUDS]` (see
-    `sklearn_adapter`). Unknown names or parameters raise ConfigError; parameter values are
+    `sklearn_recipes`). Unknown names or parameters raise ConfigError; parameter values are
     checked by `fit` (by scikit-learn's own checks here for the adapter).
     """
     adapter = make_adapter(name, params) if name not in MODELS else None

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 #: The suffix of a learner that also sees the passive shape (SUDS): ``GMR+SUDS``.
 SUDS_SUFFIX = "+SUDS"
 #: Tags: the paper's five; ``models="survey"`` of a campaign; ``partial_fit``; the
-#: scikit-learn baselines of `sklearn_adapter.BASELINES`.
+#: scikit-learn baselines of `baselines.BASELINES`.
 TAGS = ("paper", "survey", "online", "baseline")
 
 
