@@ -8,4 +8,4 @@ it is the one module allowed to import cli (pyproject.toml, [tool.importlinter])
 from cli import app
 
 if __name__ == "__main__":
-    app()
+    app(prog_name="suds-exp")

@@ -53,6 +53,17 @@ def parse_freqs(text: str | None) -> tuple[float, ...]:
     return freqs
 
 
+def parse_freq(text: str) -> float:
+    """``"1/2"`` -> 0.5 Hz: one frequency (a gait's); a list is refused."""
+    freqs = parse_freqs(text)
+    if len(freqs) != 1:
+        raise ConfigError(
+            f"frequency_hz {text!r}: expected one frequency in Hz, such as 1/2",
+            param="frequency_hz",
+        )
+    return freqs[0]
+
+
 def parse_cycles(text: str | None) -> tuple[int, int]:
     """``"10:30"`` -> (10, 30); ``"12"`` -> (12, 12); None -> (10, 30)."""
     if not text:
