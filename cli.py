@@ -366,12 +366,15 @@ def simulate(
     out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
     config: SimConfigOption = None,
     gaits: Annotated[
-        str | None, typer.Option(help="Comma list, e.g. S+,O (default: all five).")
+        str | None, typer.Option(help="Comma list, e.g. S+,O (default: all five).", metavar="GAITS")
     ] = None,
-    freqs: Annotated[str | None, typer.Option(help="Hz, comma list (default: 1/3,1/2,1).")] = None,
+    freqs: Annotated[
+        str | None, typer.Option(help="Hz, comma list (default: 1/3,1/2,1).", metavar="HZ,...")
+    ] = None,
     repeats: Annotated[int, typer.Option(help="Trials per condition.")] = 4,
     cycles: Annotated[
-        str | None, typer.Option(help="Cycles per trial MIN:MAX (default: 10:30).")
+        str | None,
+        typer.Option(help="Cycles per trial MIN:MAX (default: 10:30).", metavar="MIN:MAX"),
     ] = None,
     seed: Annotated[int, typer.Option(help="Same seed, same files.")] = 0,
     effect: ScheduleOption = None,
@@ -473,7 +476,10 @@ def preprocess(
         str | None, typer.Option(help="Name of a new version (default: v<id>).")
     ] = None,
     param: Annotated[
-        list[str] | None, typer.Option("--param", help="KEY=VALUE over the defaults; repeatable.")
+        list[str] | None,
+        typer.Option(
+            "--param", help="KEY=VALUE over the defaults; repeatable.", metavar="KEY=VALUE"
+        ),
     ] = None,
     trials_: TrialsOption = None,
     list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
@@ -519,12 +525,16 @@ CampaignModelsOption = Annotated[
     str | None,
     typer.Option(
         help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
-        "(+SUDS), sklearn:ClassName[+SUDS]; survey = the five and the baselines."
+        "(+SUDS), sklearn:ClassName (+SUDS); survey = the five and the baselines.",
+        metavar="LEARNERS",
     ),
 ]
 ModelParamOption = Annotated[
     list[str] | None,
-    typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
+    typer.Option(
+        help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01.",
+        metavar="NAME.KEY=VALUE",
+    ),
 ]
 SkipInfeasibleOption = Annotated[
     bool | None,
@@ -549,21 +559,34 @@ def run(
     ] = None,
     sweep: Annotated[
         str | None,
-        typer.Option(help="Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper."),
+        typer.Option(
+            help="Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper.",
+            metavar="CYCLES",
+        ),
     ] = None,
     train_conditions: Annotated[
-        str | None, typer.Option(help="GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).")
+        str | None,
+        typer.Option(
+            help="GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).",
+            metavar="CONDITIONS",
+        ),
     ] = None,
-    test_conditions: Annotated[str | None, typer.Option(help="As --train-conditions.")] = None,
+    test_conditions: Annotated[
+        str | None, typer.Option(help="As --train-conditions.", metavar="CONDITIONS")
+    ] = None,
     mode: Annotated[
-        str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
+        str | None,
+        typer.Option(help="SUDS learners: measured or rollout (default measured).", metavar="MODE"),
     ] = None,
     model_param: ModelParamOption = None,
     skip_infeasible: SkipInfeasibleOption = None,
     jobs: JobsOption = 1,
-    backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
+    backend: Annotated[
+        str, typer.Option(help="loky (this machine) or dask.", metavar="NAME")
+    ] = "loky",
     scheduler: Annotated[
-        str | None, typer.Option(help="dask scheduler address, e.g. tcp://host:8786.")
+        str | None,
+        typer.Option(help="dask scheduler address, e.g. tcp://host:8786.", metavar="URL"),
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -823,7 +846,10 @@ def demo(
 def stream(
     name: Annotated[str, typer.Argument(help="Stream name (created, or continued).")],
     models: Annotated[
-        str, typer.Option(help="Learners, comma-separated; online ones keep learning.")
+        str,
+        typer.Option(
+            help="Learners, comma-separated; online ones keep learning.", metavar="LEARNERS"
+        ),
     ] = "GMR,OnlineGMR",
     trials_: TrialsOption = None,
     prep: PrepOption = None,
