@@ -115,6 +115,7 @@ DbOption = Annotated[
     ),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
+CsvOption = Annotated[bool, typer.Option("--csv", help="Print the table as CSV on stdout.")]
 
 
 def old_name(flag: str, new: str):
@@ -221,6 +222,13 @@ def main(
     pass
 
 
+def db_path(db: Path | None) -> Path:
+    """The database file: ``--db``, else ``$SUDS_DB`` or ./suds.duckdb."""
+    from suds_exp.store.engine import default_db_path
+
+    return db if db is not None else default_db_path()
+
+
 def open_store(db: Path | None) -> Store:
     # imported here: `--version` and `--help` need neither SQLAlchemy nor pandas
     from suds_exp.store import Store, default_db_path
@@ -303,17 +311,18 @@ def ingest(
 
 
 @command()
-def trials(db: DbOption = None, json_: JsonOption = False) -> None:
+def trials(db: DbOption = None, json_: JsonOption = False, csv: CsvOption = False) -> None:
     """List the trials and their conditions.
 
     Examples:
       suds-exp trials
       suds-exp trials --json
+      suds-exp trials --csv
     """
     from suds_exp.commands.ingest import print_trials
-    from suds_exp.ingest import list_trials
+    from suds_exp.store.rows import trial_rows
 
-    print_trials(list_trials(open_store(db)), json_)
+    print_trials(trial_rows(db_path(db)), json_, csv)
 
 
 @command()
@@ -321,6 +330,7 @@ def sql(
     query: Annotated[str, typer.Argument(help="SQL to run on a read-only connection.")],
     db: DbOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
 ) -> None:
     """Run a read-only SQL query and print the result; statements that write are refused.
 
@@ -330,13 +340,15 @@ def sql(
       suds-exp sql "SELECT gait, count(*) AS n FROM trials GROUP BY gait"
       suds-exp sql "SELECT id, name FROM prep_versions" --json
     """
-    from suds_exp.store import run_readonly
+    from suds_exp.store.rows import query_rows
 
-    frame = run_readonly(open_store(db), query)
+    rows = query_rows(db_path(db), query)
     if json_:
-        console.print_json(frame)
+        console.print_json(rows)
+    elif csv:
+        console.print_csv(rows)
     else:
-        console.print_frame(frame)
+        console.print_rows(rows)
 
 
 EffectOption = Annotated[
@@ -450,6 +462,7 @@ def effects(
     config: SimConfigOption = None,
     effect: EffectOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
 ) -> None:
     """List the simulator's named effects: parameters, units, nominal values, ranges.
 
@@ -458,16 +471,18 @@ def effects(
     Examples:
       suds-exp effects
       suds-exp effects --effect hinge_damping=on --json
+      suds-exp effects --csv
     """
     from suds_exp.commands.simulate import build_config, effects_table
     from suds_exp.sim import effect_library
 
+    model = build_config(config, effect or [])
     if json_:
-        console.print_json(effect_library(build_config(config, effect or [])))
+        console.print_json(effect_library(model))
+    elif csv:
+        console.print_csv(effects_table(model))
     else:
-        console.print_frame(
-            effects_table(build_config(config, effect or [])), title="effects (* = main)"
-        )
+        console.print_frame(effects_table(model), title="effects (* = main)")
 
 
 @command()

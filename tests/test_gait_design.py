@@ -277,6 +277,14 @@ def test_run_report_and_findings_work_after_verify(db, tmp_path):
     ok("report", "after", "--out", str(out), "--db", str(db))
     assert "design-1-it1.toml" in (out / "index.html").read_text()
     paper = Path(__file__).resolve().parents[1] / "suds_exp" / "experiment" / "paper.toml"
-    ok("report", "after", "--out", str(tmp_path / "r2"), "--experiment", str(paper),
-       "--db", str(db))
+    ok(
+        "report",
+        "after",
+        "--out",
+        str(tmp_path / "r2"),
+        "--experiment",
+        str(paper),
+        "--db",
+        str(db),
+    )
     ok("findings", "after", "--boot", "10", "--db", str(db))

@@ -88,8 +88,8 @@ def test_config_files_toml_and_json(tmp_path):
     ],
 )
 def test_hinge_values_outside_their_range_name_the_setting_and_range(tmp_path, values):
-    (section, params), = values.items()
-    (name, _), = params.items()
+    ((section, params),) = values.items()
+    ((name, _),) = params.items()
     path = tmp_path / "c.json"
     path.write_text(json.dumps(values))
     with pytest.raises(ConfigError, match=rf"config\.{section}\.{name}: .* outside its range"):

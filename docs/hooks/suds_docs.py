@@ -71,10 +71,7 @@ def math_image(match: re.Match) -> str:
     with matplotlib.rc_context({"svg.hashsalt": "suds-docs", "svg.fonttype": "path"}):
         mathtext.math_to_image(f"${tex}$", buf, format="svg", dpi=110)
     data = base64.b64encode(buf.getvalue()).decode()
-    return (
-        f'<img class="math" alt="{html.escape(tex)}" '
-        f'src="data:image/svg+xml;base64,{data}">'
-    )
+    return f'<img class="math" alt="{html.escape(tex)}" src="data:image/svg+xml;base64,{data}">'
 
 
 # --- database --------------------------------------------------------------------------
