@@ -237,7 +237,7 @@ def open_store(db: Path | None) -> Store:
 
 
 @command()
-def init(db: DbOption = None) -> None:
+def init(db: DbOption = None, json_: JsonOption = False) -> None:
     """Create the database, or upgrade it to the latest schema.
 
     Examples:
@@ -245,6 +245,9 @@ def init(db: DbOption = None) -> None:
     """
     store = open_store(db)
     applied = store.upgrade()
+    if json_:
+        console.print_json({"db": str(store.path), "applied": applied})
+        return
     console.out.print(
         f"{store.path}: " + (f"applied {', '.join(applied)}" if applied else "up to date")
     )

@@ -89,6 +89,8 @@ def test_one_name_for_one_thing(command):
         assert shown["--model"].metavar == "LEARNER"
     if "--jobs" in shown:
         assert "-j" in shown
+    # every command can answer a script: demo narrates, the others print a result
+    assert "--json" in shown
 
 
 def test_help_keeps_the_brackets_of_an_extra():

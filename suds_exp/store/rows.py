@@ -108,3 +108,29 @@ def query_problem(exc: BaseException) -> StoreError:
 def trial_rows(path: Path) -> Rows:
     """One row per trial: id, file, format, condition, rate (Hz), frames, markers."""
     return read_rows(path, TRIALS_SQL)
+
+
+#: what a database holds, as a `Store` shows it: table -> what its rows are called
+CONTENTS = {"trials": "trials", "prep_versions": "versions", "campaigns": "campaigns",
+            "results": "results"}  # fmt: skip
+
+
+def contents(path: Path) -> dict[str, int] | str:
+    """How many trials, versions, campaigns and results the file ``path`` holds, read in
+    one try (no waiting: a notebook's display must not hang); else why not, in words."""
+    path = Path(path)
+    if not path.exists():
+        return "no file yet"
+    try:
+        conn = duckdb.connect(str(path), read_only=True)
+    except duckdb.Error as exc:
+        return "busy (held by another process)" if "lock" in str(exc) else "unreadable"
+    try:
+        have = {r[0] for r in conn.execute("SELECT table_name FROM duckdb_tables()").fetchall()}
+        return {
+            word: conn.execute(f'SELECT count(*) FROM "{table}"').fetchone()[0]
+            for table, word in CONTENTS.items()
+            if table in have
+        }
+    finally:
+        conn.close()

@@ -14,6 +14,7 @@ import duckdb
 import pandas as pd
 import sqlalchemy as sa
 
+from suds_exp.display import Summary
 from suds_exp.errors import StoreError
 from suds_exp.store import migrate
 from suds_exp.store.engine import default_db_path, make_engine, open_problem, retry_on_lock
@@ -23,7 +24,7 @@ from suds_exp.store.lock import WriteLock
 _frame_names = itertools.count()
 
 
-class Store:
+class Store(Summary):
     """A DuckDB database file, opened only for the length of each block.
 
     ``with store.write() as conn`` gives a SQLAlchemy connection inside one transaction
@@ -43,8 +44,11 @@ class Store:
         self.path = Path(path) if path is not None else default_db_path()
         self._migrated = False
 
-    def __repr__(self) -> str:
-        return f"Store({str(self.path)!r})"
+    def _summary(self):
+        from suds_exp.store.rows import contents
+
+        size = self.path.stat().st_size / 1e6 if self.path.exists() else 0.0
+        return f"Store {self.path}", [("size", f"{size:.1f} MB"), ("holds", contents(self.path))]
 
     # -- connections ---------------------------------------------------------------
     def locked(self, command: str, name: str | None = None, wait_s: float | None = None):
