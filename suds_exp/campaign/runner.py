@@ -38,7 +38,6 @@ import sqlalchemy as sa
 from threadpoolctl import threadpool_limits
 
 from suds_exp.campaign import tables
-from suds_exp.display import Summary
 from suds_exp.campaign.bank import SampleBank, rounded_conditions
 from suds_exp.campaign.definition import (
     CampaignOptions,
@@ -52,6 +51,7 @@ from suds_exp.campaign.grid import enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
+from suds_exp.display import Summary
 from suds_exp.errors import CampaignError, ClusterLostError, StoreError
 from suds_exp.ingest import stored_design
 from suds_exp.progress import progress_bar
