@@ -80,7 +80,7 @@ def test_the_tutorial_runs(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize(
     "page",
-    ["how-to/own-recordings.md", "how-to/sql-and-pandas.md"],
+    ["how-to/own-recordings.md", "how-to/sql-and-pandas.md", "how-to/notebooks.md"],
 )
 def test_how_to_guides_run(page, tmp_path, monkeypatch):
     run_page(page, tmp_path, monkeypatch)
