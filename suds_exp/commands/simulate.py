@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from suds_exp import console
 from suds_exp.errors import ConfigError
 from suds_exp.robot import FREQUENCIES_HZ, GAITS, parse_frequency
 from suds_exp.sim.config import SimConfig, load_config
@@ -200,6 +201,18 @@ def effects_table(config: SimConfig | None = None) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def say_if_compiling() -> None:
+    """On stderr, before a first simulation after an install: the kernels compile once."""
+    from suds_exp.sim.precompile import COMPILE_S, kernels_cached
+
+    if not kernels_cached():
+        console.err.print(
+            f"compiling the simulator once (numba): about {COMPILE_S} s on an idle core, "
+            "more on a busy one; later runs load it from the cache",
+            highlight=False,
+        )
+
+
 def simulate_options(
     out: Path,
     config_path: Path | None = None,
@@ -216,6 +229,8 @@ def simulate_options(
     """`suds-exp simulate` from its option strings: the paper's design (`simulate_command`)
     or, with ``gait_file``, trials of that gait (`simulate_file_command`); ingested into
     ``store`` when one is given. A JSON-ready summary."""
+    if progress:
+        say_if_compiling()
     if gait_file is not None:
         return _simulate_gait_file(
             out,
