@@ -47,9 +47,11 @@ def test_a_small_command_imports_no_heavy_library(db, args):
 
 
 @pytest.mark.parametrize(
-    "args", [["trials"], ["trials", "--csv"], ["sql", "SELECT 1 AS one"]], ids=" ".join
+    "args",
+    [["trials"], ["trials", "--csv"], ["sql", "SELECT 1 AS one"], ["status", "c"]],
+    ids=" ".join,
 )
-def test_trials_and_sql_read_without_pandas_or_sqlalchemy(db, args):
+def test_trials_sql_and_status_read_without_pandas_or_sqlalchemy(db, args):
     """They read a few rows through DuckDB alone (`suds_exp.store.rows`)."""
     probe = PROBE.format(heavy=("pandas", "sqlalchemy"))
     out = subprocess.run(

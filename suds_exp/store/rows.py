@@ -9,7 +9,8 @@ wants, loading pandas then.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -70,20 +71,35 @@ def plain(value: Any) -> Any:
     return value
 
 
-def read_rows(path: Path, query: str, params: Sequence | Mapping | None = None) -> Rows:
-    """Run ``query`` (DuckDB SQL, parameters ``?``/``$name`` in ``params``) on a read-only
-    connection to the database file ``path``; waits out a writer as `Store.read` does."""
+@contextmanager
+def read_connection(path: Path) -> Iterator[duckdb.DuckDBPyConnection]:
+    """A read-only DuckDB connection to the database file ``path`` for the block; waits
+    out a writer as `Store.read` does, and refuses a file that is not there."""
     path = Path(path)
     if not path.exists():
         raise StoreError(f"{path}: no database here; create one first", step="init")
     migrate.available_migrations()  # a broken installation is refused here too
     conn = retry_on_lock(lambda: duckdb.connect(str(path), read_only=True), path)
     try:
+        yield conn
+    finally:
+        conn.close()
+
+
+def text_literal(value: str) -> str:
+    """``value`` as a SQL string literal (quotes doubled), for queries of the small
+    commands: DuckDB loads pandas (about a second) on the first bound parameter, to check
+    whether it is a pandas value."""
+    return "'" + str(value).replace("'", "''") + "'"
+
+
+def read_rows(path: Path, query: str, params: Sequence | Mapping | None = None) -> Rows:
+    """Run ``query`` (DuckDB SQL, parameters ``?``/``$name`` in ``params``) on a read-only
+    connection to the database file ``path``; waits out a writer as `Store.read` does."""
+    with read_connection(path) as conn:
         cursor = conn.execute(query, params or [])
         columns = tuple(d[0] for d in cursor.description or ())
         return Rows(columns, cursor.fetchall())
-    finally:
-        conn.close()
 
 
 def query_rows(path: Path, query: str) -> Rows:

@@ -8,11 +8,9 @@ import threading
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import duckdb
-import pandas as pd
-import sqlalchemy as sa
 
 from suds_exp.display import Summary
 from suds_exp.errors import StoreError
@@ -20,6 +18,10 @@ from suds_exp.store import migrate
 from suds_exp.store.engine import default_db_path, make_engine, open_problem, retry_on_lock
 from suds_exp.store.integrity import mark_written
 from suds_exp.store.lock import WriteLock
+
+if TYPE_CHECKING:  # loaded when a block opens the file: a Store is made without them
+    import pandas as pd
+    import sqlalchemy as sa
 
 _frame_names = itertools.count()
 
@@ -114,8 +116,12 @@ class Store(Summary):
         try:
             with self._connect(read_only=False) as conn:
                 yield conn
-        except (duckdb.Error, sa.exc.DBAPIError) as exc:
-            raise _write_problem(exc, self.path) from None
+        except Exception as exc:
+            import sqlalchemy as sa  # loaded by now: the block's engine is SQLAlchemy's
+
+            if isinstance(exc, duckdb.Error | sa.exc.DBAPIError):
+                raise _write_problem(exc, self.path) from None
+            raise
         finally:
             mark_written(self.path)
 
@@ -161,6 +167,8 @@ class Store(Summary):
         ``query`` is a SQLAlchemy Core statement (its bound parameters are used) or SQL
         text with DuckDB parameters (``?`` / ``$1`` / ``$name``) given in ``params``.
         """
+        import sqlalchemy as sa
+
         raw = conn.connection.driver_connection
         if isinstance(query, sa.sql.ClauseElement):
             compiled = query.compile(dialect=conn.dialect)
