@@ -7,10 +7,14 @@ Each command parses options and calls one library function; the work lives in
 from __future__ import annotations
 
 import functools
+import inspect
+import typing
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
+import typer.core
+from rich.markup import escape
 
 from suds_exp import __version__, console
 from suds_exp.commands.messages import user_message
@@ -19,6 +23,81 @@ from suds_exp.errors import SudsError
 if TYPE_CHECKING:
     from suds_exp.store import Store
 
+
+def _source_help(text: str | None) -> str | None:
+    """A help text as its source reads: rich markup escaped (``suds-exp[pose]`` stays), a
+    prose paragraph's line breaks joined (rich keeps them), an ``Examples:`` paragraph kept
+    a command a line."""
+    if not text:
+        return text
+    paragraphs = inspect.cleandoc(text).split("\n\n")
+    kept = [p if p.startswith("Examples:") else " ".join(p.split("\n")) for p in paragraphs]
+    return escape("\n\n".join(kept))
+
+
+#: metavars of options that give none, by type (click's words): a flag shows no value
+VALUE_NAMES = {int: "INTEGER", float: "FLOAT", str: "TEXT", Path: "PATH"}
+
+
+def _value_name(param: typer.core.TyperOption) -> str:
+    kind = param.type_descriptor.annotation
+    if typing.get_origin(kind) is list:
+        (kind,) = typing.get_args(kind)
+    return VALUE_NAMES.get(kind, "VALUE")
+
+
+class _Argument(typer.core.TyperArgument):
+    # its name column already shows the metavar; typer would add the Python type
+    def display_type_rich(self, ctx):
+        return None
+
+
+class _SourceHelp:
+    """Help that shows what the source says: flags without a type label, values with a
+    metavar, arguments in upper case, brackets and examples kept."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.help = _source_help(self.help)
+        for param in self.params:
+            _label(param)
+
+    def get_help_option(self, ctx):
+        option = super().get_help_option(ctx)
+        if option is not None:
+            _label(option)
+        return option
+
+
+def _label(param) -> None:
+    param.help = _source_help(getattr(param, "help", None))
+    if isinstance(param, typer.core.TyperArgument):
+        param.__class__ = _Argument
+        param.metavar = param.metavar or param.name.upper()
+    elif param.metavar is None:
+        param.metavar = "" if param.is_flag else _value_name(param)
+
+
+class Command(_SourceHelp, typer.core.TyperCommand):
+    def collect_usage_pieces(self, ctx):
+        # click's convention: NAME required, [NAME] optional, NAME... repeated
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if isinstance(param, typer.core.TyperArgument):
+                name = param.metavar + ("..." if param.nargs != 1 else "")
+                pieces.append(name if param.required else f"[{name}]")
+        return pieces
+
+
+class Group(_SourceHelp, typer.core.TyperGroup):
+    pass
+
+
+def sub_app(help: str) -> typer.Typer:
+    """A group of commands (``suds-exp gait ...``)."""
+    return typer.Typer(help=help, no_args_is_help=True, cls=Group)
+
+
 app = typer.Typer(
     name="suds-exp",
     help="Learn the motility map of an under-actuated robot from motion capture, "
@@ -26,6 +105,7 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    cls=Group,
 )
 
 DbOption = Annotated[
@@ -35,6 +115,7 @@ DbOption = Annotated[
     ),
 ]
 JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
+CsvOption = Annotated[bool, typer.Option("--csv", help="Print the table as CSV on stdout.")]
 
 
 def old_name(flag: str, new: str):
@@ -49,6 +130,39 @@ def either(value, old):
 
 
 QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
+
+
+def option(help: str, *flags: str, metavar: str | None = None, **kwargs):
+    """`typer.Option` with its help first, so that a declaration fits one line."""
+    return typer.Option(*flags, help=help, metavar=metavar, **kwargs)
+
+
+# Options that several commands take: declared once, so that they are named, written and
+# explained alike everywhere (a command's own help may say more in its docstring).
+PrepOption = Annotated[
+    str | None, option("Preprocessing version (default: the only one).", metavar="VERSION")
+]
+TrialsOption = Annotated[
+    str | None, option("Trial ids, e.g. 1,2,5-8 (default: all).", "--trials", metavar="IDS")
+]
+ModelOption = Annotated[
+    str, option("Learner, e.g. GMR, MLP, GMR+SUDS (suds_exp.models).", metavar="LEARNER")
+]
+LearnerAlias = Annotated[str | None, old_name("--learner", "--model")]
+FreqOption = Annotated[str, option("Gait frequency, Hz (one value, e.g. 1/2).", metavar="HZ")]
+FreqAlias = Annotated[str | None, old_name("--freq", "--freqs")]
+TargetFreqsOption = Annotated[
+    str | None, option("Target frequencies, Hz (default 1/2).", "--freqs", metavar="HZ,...")
+]
+TargetOption = Annotated[
+    list[Path] | None, option("Target gait file (CSV or TOML); repeatable.", metavar="FILE")
+]
+CampaignArgument = Annotated[str, typer.Argument(help="Campaign name.")]
+GridOption = Annotated[int, option("Points per joint axis.", metavar="N")]
+RangeOption = Annotated[float, option("Half range of phi1, phi2 (rad).", "--range", metavar="RAD")]
+JobsOption = Annotated[
+    int, option("Worker processes (-1: all cores).", "--jobs", "-j", metavar="N")
+]
 
 
 def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None = None, **kwargs):
@@ -84,7 +198,7 @@ def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None =
                 )
                 raise typer.Exit(130) from None
 
-        return (on or app).command(*args, **kwargs)(run)
+        return (on or app).command(*args, cls=Command, **kwargs)(run)
 
     return wrap
 
@@ -108,6 +222,13 @@ def main(
     pass
 
 
+def db_path(db: Path | None) -> Path:
+    """The database file: ``--db``, else ``$SUDS_DB`` or ./suds.duckdb."""
+    from suds_exp.store.engine import default_db_path
+
+    return db if db is not None else default_db_path()
+
+
 def open_store(db: Path | None) -> Store:
     # imported here: `--version` and `--help` need neither SQLAlchemy nor pandas
     from suds_exp.store import Store, default_db_path
@@ -116,10 +237,17 @@ def open_store(db: Path | None) -> Store:
 
 
 @command()
-def init(db: DbOption = None) -> None:
-    """Create the database, or upgrade it to the latest schema."""
+def init(db: DbOption = None, json_: JsonOption = False) -> None:
+    """Create the database, or upgrade it to the latest schema.
+
+    Examples:
+      suds-exp init --db lab.duckdb
+    """
     store = open_store(db)
     applied = store.upgrade()
+    if json_:
+        console.print_json({"db": str(store.path), "applied": applied})
+        return
     console.out.print(
         f"{store.path}: " + (f"applied {', '.join(applied)}" if applied else "up to date")
     )
@@ -157,11 +285,14 @@ def ingest(
     quiet: QuietOption = False,
 ) -> None:
     """Ingest QTM TSV, C3D, Vicon Nexus / Motive / marker CSV and TRC files, and keypoint
-    files of DeepLabCut, SLEAP, Lightning Pose and Anipose (needs suds-exp\\[pose]).
+    files of DeepLabCut, SLEAP, Lightning Pose and Anipose (needs suds-exp[pose]).
 
     Each file is one transaction; a bad file is reported in one line and the others are
-    still stored (exit status 2 at the end). Example: suds-exp ingest data/ --manifest
-    data/manifest.csv; suds-exp ingest mouse.h5 --fps 30 --mm-per-px 0.1
+    still stored (exit status 2 at the end); a file already stored is skipped. Keypoint
+    files take --fps and --mm-per-px when the file does not say them.
+
+    Examples:
+      suds-exp ingest sim-data --manifest sim-data/manifest.csv
     """
     from suds_exp.commands.ingest import print_ingest
     from suds_exp.experiment import load_design
@@ -183,12 +314,18 @@ def ingest(
 
 
 @command()
-def trials(db: DbOption = None, json_: JsonOption = False) -> None:
-    """List the trials and their conditions."""
-    from suds_exp.commands.ingest import print_trials
-    from suds_exp.ingest import list_trials
+def trials(db: DbOption = None, json_: JsonOption = False, csv: CsvOption = False) -> None:
+    """List the trials and their conditions.
 
-    print_trials(list_trials(open_store(db)), json_)
+    Examples:
+      suds-exp trials
+      suds-exp trials --json
+      suds-exp trials --csv
+    """
+    from suds_exp.commands.ingest import print_trials
+    from suds_exp.store.rows import trial_rows
+
+    print_trials(trial_rows(db_path(db)), json_, csv)
 
 
 @command()
@@ -196,30 +333,46 @@ def sql(
     query: Annotated[str, typer.Argument(help="SQL to run on a read-only connection.")],
     db: DbOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
 ) -> None:
     """Run a read-only SQL query and print the result; statements that write are refused.
 
-    Example: suds-exp sql "SELECT gait, count(*) FROM trials GROUP BY gait"
-    """
-    from suds_exp.store import run_readonly
+    Tables and views: docs/reference/database.md of the documentation.
 
-    frame = run_readonly(open_store(db), query)
+    Examples:
+      suds-exp sql "SELECT gait, count(*) AS n FROM trials GROUP BY gait"
+      suds-exp sql "SELECT id, name FROM prep_versions" --json
+    """
+    from suds_exp.store.rows import query_rows
+
+    rows = query_rows(db_path(db), query)
     if json_:
-        console.print_json(frame)
+        console.print_json(rows)
+    elif csv:
+        console.print_csv(rows)
     else:
-        console.print_frame(frame)
+        console.print_rows(rows)
 
 
 EffectOption = Annotated[
     list[str] | None,
-    typer.Option(
+    option(
+        "A simulator effect NAME=VALUE (or NAME.PARAM=VALUE, on, off); repeatable.",
         "--effect",
-        help="NAME=VALUE (or NAME.PARAM=VALUE, on, off); repeatable. "
-        "simulate also takes a schedule NAME=VALUE@TIMEs, e.g. flippers=locked@40s.",
+        metavar="NAME=VALUE",
+    ),
+]
+ScheduleOption = Annotated[
+    list[str] | None,
+    option(
+        "A simulator effect NAME=VALUE (or NAME.PARAM=VALUE, on, off), or its schedule "
+        "NAME=VALUE@TIMEs, e.g. flippers=locked@40s; repeatable.",
+        "--effect",
+        metavar="NAME=VALUE[@T]",
     ),
 ]
 SimConfigOption = Annotated[
-    Path | None, typer.Option("--config", help="Simulator config (.toml or .json).")
+    Path | None, option("Simulator config (.toml or .json).", "--config", metavar="FILE")
 ]
 
 
@@ -228,15 +381,18 @@ def simulate(
     out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
     config: SimConfigOption = None,
     gaits: Annotated[
-        str | None, typer.Option(help="Comma list, e.g. S+,O (default: all five).")
+        str | None, typer.Option(help="Comma list, e.g. S+,O (default: all five).", metavar="GAITS")
     ] = None,
-    freqs: Annotated[str | None, typer.Option(help="Hz, comma list (default: 1/3,1/2,1).")] = None,
+    freqs: Annotated[
+        str | None, typer.Option(help="Hz, comma list (default: 1/3,1/2,1).", metavar="HZ,...")
+    ] = None,
     repeats: Annotated[int, typer.Option(help="Trials per condition.")] = 4,
     cycles: Annotated[
-        str | None, typer.Option(help="Cycles per trial MIN:MAX (default: 10:30).")
+        str | None,
+        typer.Option(help="Cycles per trial MIN:MAX (default: 10:30).", metavar="MIN:MAX"),
     ] = None,
     seed: Annotated[int, typer.Option(help="Same seed, same files.")] = 0,
-    effect: EffectOption = None,
+    effect: ScheduleOption = None,
     ingest: Annotated[bool, typer.Option("--ingest", help="Ingest the result into --db.")] = False,
     gait_file: Annotated[
         Path | None,
@@ -248,8 +404,14 @@ def simulate(
 ) -> None:
     """Simulate the swimmer and write QTM TSV captures, truth Parquet files and a manifest.
 
-    Example: suds-exp simulate --out sim-data --gaits O,D+ --repeats 2 --effect hinge_damping=on;
-    suds-exp simulate --out ell --gait-file ellipse.toml --freqs 1/2 --ingest
+    The first run after an install compiles the simulator's kernels once (numba).
+
+    Examples:
+      suds-exp simulate --out sim-o --gaits O --freqs 1/2 --repeats 1 --cycles 3
+      suds-exp simulate --out damped --gaits O --freqs 1/2 --repeats 1 --cycles 3 \\
+        --effect hinge_damping=on
+      suds-exp simulate --out ell --gait-file ellipse.toml --freqs 1/2 --repeats 1 --cycles 3 \\
+        --ingest
     """
     from suds_exp.commands.simulate import simulate_options, simulate_text
 
@@ -275,8 +437,8 @@ def simulate(
 @command(flags={"half_range": "--range"})
 def connection(
     out: Annotated[Path, typer.Option(help="CSV file; figures go beside it (_vx/_vy/_wz.png).")],
-    grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,
-    range_: Annotated[float, typer.Option("--range", help="Half range of phi1, phi2 (rad).")] = 2.5,
+    grid: GridOption = 21,
+    range_: RangeOption = 2.5,
     geometry: Annotated[str, typer.Option(help="robot or classic (3 equal links).")] = "robot",
     config: SimConfigOption = None,
     effect: EffectOption = None,
@@ -284,7 +446,10 @@ def connection(
 ) -> None:
     """Local connection with flippers locked: body velocity per unit joint rate on a grid.
 
-    Example: suds-exp connection --out reports/connection.csv --geometry classic
+    The grid is --grid points per joint over [-RANGE, RANGE] rad.
+
+    Examples:
+      suds-exp connection --out reports/connection.csv --geometry classic --grid 11
     """
     from suds_exp.commands.simulate import build_config, connection_command
 
@@ -300,20 +465,27 @@ def effects(
     config: SimConfigOption = None,
     effect: EffectOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
 ) -> None:
     """List the simulator's named effects: parameters, units, nominal values, ranges.
 
-    Example: suds-exp effects --json
+    With --config and --effect, the values of that model.
+
+    Examples:
+      suds-exp effects
+      suds-exp effects --effect hinge_damping=on --json
+      suds-exp effects --csv
     """
     from suds_exp.commands.simulate import build_config, effects_table
     from suds_exp.sim import effect_library
 
+    model = build_config(config, effect or [])
     if json_:
-        console.print_json(effect_library(build_config(config, effect or [])))
+        console.print_json(effect_library(model))
+    elif csv:
+        console.print_csv(effects_table(model))
     else:
-        console.print_frame(
-            effects_table(build_config(config, effect or [])), title="effects (* = main)"
-        )
+        console.print_frame(effects_table(model), title="effects (* = main)")
 
 
 @command()
@@ -322,11 +494,12 @@ def preprocess(
         str | None, typer.Option(help="Name of a new version (default: v<id>).")
     ] = None,
     param: Annotated[
-        list[str] | None, typer.Option("--param", help="KEY=VALUE over the defaults; repeatable.")
+        list[str] | None,
+        typer.Option(
+            "--param", help="KEY=VALUE over the defaults; repeatable.", metavar="KEY=VALUE"
+        ),
     ] = None,
-    trials_: Annotated[
-        str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 (default: all).")
-    ] = None,
+    trials_: TrialsOption = None,
     list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
     body: Annotated[
         str | None,
@@ -343,9 +516,13 @@ def preprocess(
     """Turn markers into samples (shape, phase, body velocity) as a stored version.
 
     The same parameters are the same version: re-running skips the trials already done.
-    Example: suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-20;
-    suds-exp preprocess --body snake.toml (a marker chain: shape modes of chord angles)
-    suds-exp preprocess --preset paper --name paper (the paper's own processing)
+    --preset paper is the paper's own processing; --body FILE.toml describes another body
+    (a marker chain: shape modes of chord angles).
+
+    Examples:
+      suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-2
+      suds-exp preprocess --preset paper --name paper
+      suds-exp preprocess --list
     """
     from suds_exp.commands.preprocess import preprocess_command, preprocess_text, print_versions
 
@@ -366,12 +543,16 @@ CampaignModelsOption = Annotated[
     str | None,
     typer.Option(
         help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
-        "(+SUDS), sklearn:ClassName[+SUDS]; survey = the five and the baselines."
+        "(+SUDS), sklearn:ClassName (+SUDS); survey = the five and the baselines.",
+        metavar="LEARNERS",
     ),
 ]
 ModelParamOption = Annotated[
     list[str] | None,
-    typer.Option(help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01."),
+    typer.Option(
+        help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01.",
+        metavar="NAME.KEY=VALUE",
+    ),
 ]
 SkipInfeasibleOption = Annotated[
     bool | None,
@@ -386,7 +567,7 @@ SkipInfeasibleOption = Annotated[
 @command()
 def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
-    prep: Annotated[str | None, typer.Option(help="Preprocessing version of the samples.")] = None,
+    prep: PrepOption = None,
     models: CampaignModelsOption = None,
     boots: Annotated[
         int | None, typer.Option(help="Draws per (train, test) pair (default 10).")
@@ -396,21 +577,34 @@ def run(
     ] = None,
     sweep: Annotated[
         str | None,
-        typer.Option(help="Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper."),
+        typer.Option(
+            help="Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper.",
+            metavar="CYCLES",
+        ),
     ] = None,
     train_conditions: Annotated[
-        str | None, typer.Option(help="GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).")
+        str | None,
+        typer.Option(
+            help="GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).",
+            metavar="CONDITIONS",
+        ),
     ] = None,
-    test_conditions: Annotated[str | None, typer.Option(help="As --train-conditions.")] = None,
+    test_conditions: Annotated[
+        str | None, typer.Option(help="As --train-conditions.", metavar="CONDITIONS")
+    ] = None,
     mode: Annotated[
-        str | None, typer.Option(help="SUDS learners: measured or rollout (default measured).")
+        str | None,
+        typer.Option(help="SUDS learners: measured or rollout (default measured).", metavar="MODE"),
     ] = None,
     model_param: ModelParamOption = None,
     skip_infeasible: SkipInfeasibleOption = None,
-    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Workers (-1: all cores).")] = 1,
-    backend: Annotated[str, typer.Option(help="loky (this machine) or dask.")] = "loky",
+    jobs: JobsOption = 1,
+    backend: Annotated[
+        str, typer.Option(help="loky (this machine) or dask.", metavar="NAME")
+    ] = "loky",
     scheduler: Annotated[
-        str | None, typer.Option(help="dask scheduler address, e.g. tcp://host:8786.")
+        str | None,
+        typer.Option(help="dask scheduler address, e.g. tcp://host:8786.", metavar="URL"),
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -419,7 +613,11 @@ def run(
     """Create or continue a bootstrap campaign; Ctrl-C stops after saving finished jobs.
 
     An option left out of a continued campaign takes its stored value; a different value
-    is refused. Example: suds-exp run paper --prep default --sweep paper --jobs 2
+    is refused. The paper's campaign on its design: suds-exp run paper --sweep paper -j 2.
+
+    Examples:
+      suds-exp run quick --models GMR,kNN --boots 2 --train-cycles 2 -j 2
+      suds-exp run first --json
     """
     from suds_exp.campaign import run_campaign
     from suds_exp.commands import campaign
@@ -471,7 +669,11 @@ def survey(
     error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio (from a
     sweep); the GLM with the learner as a factor (from a main grid's cross pairs).
 
-    Example: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48 && suds-exp survey s
+    The full survey: suds-exp run s --models survey --sweep 1,2,4,8,16,30,48.
+
+    Examples:
+      suds-exp run s --models GMR,MLP --sweep 1,2 --train-cycles 2 --boots 2 \\
+        && suds-exp survey s --cycles 2 --boots 200
     """
     from suds_exp.analysis.survey import survey_json, survey_tables
     from suds_exp.commands.survey import print_survey
@@ -485,11 +687,16 @@ def survey(
 
 @command()
 def status(
-    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    name: CampaignArgument,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
-    """Jobs done / total per learner, rate and time left of a campaign (also while it runs)."""
+    """Jobs done / total per learner, rate and time left of a campaign (also while it runs).
+
+    Examples:
+      suds-exp status first
+      suds-exp status first --json
+    """
     from suds_exp.campaign import campaign_status
     from suds_exp.commands.campaign import print_status
 
@@ -502,7 +709,7 @@ def status(
 
 @command(flags={"n_cycles": "--cycles", "paper_dir": "--paper"})
 def report(
-    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    name: CampaignArgument,
     out: Annotated[Path | None, typer.Option(help="Folder (default: reports/NAME).")] = None,
     cycles: Annotated[
         int | None, typer.Option(help="Training size of box plots and GLMs (default: most common).")
@@ -522,7 +729,10 @@ def report(
 ) -> None:
     """Write a campaign's report: box plots, GLM, IQR and slope tables, paper comparison.
 
-    Example: suds-exp report paper --out reports/paper   (then open reports/paper/index.html)
+    Open index.html of the folder in a browser.
+
+    Examples:
+      suds-exp report first --out reports/first
     """
     from suds_exp.analysis import write_report
     from suds_exp.commands.report import report_document
@@ -540,7 +750,7 @@ def report(
 
 @command(flags={"n_boot": "--boots"})
 def findings(
-    name: Annotated[str, typer.Argument(help="Campaign name.")],
+    name: CampaignArgument,
     boots: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
     boot: Annotated[int | None, old_name("--boot", "--boots")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
@@ -548,30 +758,25 @@ def findings(
     json_: JsonOption = False,
 ) -> None:
     """The paper's findings F1-F10 measured on a campaign: statistic, value, 95 % bootstrap
-    interval, holds / unclear / fails / not measurable (definitions: docs/explanation/findings.md).
+    interval, holds / unclear / fails / not measurable (definitions: the documentation's
+    explanation/findings page).
 
-    Example: suds-exp findings paper --json
+    Examples:
+      suds-exp findings first --boots 100 --json
     """
     from suds_exp.commands.findings import show_findings
 
     show_findings(open_store(db), name, n_boot=either(boots, boot), seed=seed, as_json=json_)
 
 
-@command(flags={"exclude": "--exclude-candidates", "model_effects": "--model-effect"})
+@command(flags={"exclude": "--exclude-candidates", "model_effects": "--effect"})
 def discrepancy(
-    model: Annotated[
-        Path | None, typer.Option("--model", help="Starting simulator config (default: nominal).")
-    ] = None,
-    model_effect: Annotated[
-        list[str] | None,
-        typer.Option("--model-effect", help="NAME=VALUE on the starting model; repeatable."),
-    ] = None,
-    trials: Annotated[
-        str | None, typer.Option(help="Comma list of trial ids (default: all).")
-    ] = None,
-    prep: Annotated[
-        str | None, typer.Option(help="Preprocessing version (default: the only one).")
-    ] = None,
+    config: SimConfigOption = None,
+    effect: EffectOption = None,
+    model: Annotated[Path | None, old_name("--model", "--config")] = None,
+    model_effect: Annotated[list[str] | None, old_name("--model-effect", "--effect")] = None,
+    trials: TrialsOption = None,
+    prep: PrepOption = None,
     alpha: Annotated[float, typer.Option(help="Level of the test naming an effect.")] = 0.01,
     max_effects: Annotated[int, typer.Option(help="Stop after naming this many.")] = 3,
     seed: Annotated[int, typer.Option(help="Seed of the trial split and bootstraps.")] = 0,
@@ -600,7 +805,10 @@ def discrepancy(
     """Replay the trials through the simulator, find where they disagree, name the missing
     effects (fitted on half the trials, tested on the other half) and report the gap.
 
-    Example: suds-exp discrepancy --model-effect flippers=absent --max-effects 2
+    The starting model is --config with --effect applied.
+
+    Examples:
+      suds-exp discrepancy --effect flippers=absent --max-effects 1
     """
     from suds_exp.commands.discrepancy import (
         discrepancy_command,
@@ -609,7 +817,7 @@ def discrepancy(
         start_model,
     )
 
-    start = start_model(model, model_effect or [])
+    start = start_model(either(config, model), either(effect, model_effect) or [])
     # options are checked before the database is opened
     options = discrepancy_options(alpha, max_effects, seed, exclude_candidates, discover, max_terms)
     result = discrepancy_command(
@@ -625,7 +833,7 @@ def discrepancy(
 def demo(
     db: DbOption = None,
     out: Annotated[Path, typer.Option(help="Folder for the campaign report.")] = Path("reports"),
-    jobs: Annotated[int, typer.Option(help="Worker processes for the campaign.")] = 2,
+    jobs: JobsOption = 2,
     quiet: QuietOption = False,
     json_: JsonOption = False,
 ) -> None:
@@ -633,6 +841,9 @@ def demo(
 
     Simulates the paper's design into a temporary folder, ingests it, preprocesses it,
     runs a small campaign with all five learners and writes its report.
+
+    Examples:
+      suds-exp demo --db demo.duckdb --out reports -j 2
     """
     from suds_exp.console import output_lines
     from suds_exp.workflows.demo import run_demo
@@ -654,14 +865,13 @@ def demo(
 def stream(
     name: Annotated[str, typer.Argument(help="Stream name (created, or continued).")],
     models: Annotated[
-        str, typer.Option(help="Learners, comma-separated; online ones keep learning.")
+        str,
+        typer.Option(
+            help="Learners, comma-separated; online ones keep learning.", metavar="LEARNERS"
+        ),
     ] = "GMR,OnlineGMR",
-    trials_: Annotated[
-        str | None, typer.Option("--trials", help="Trial ids, e.g. 1,2,5-8 (default: all).")
-    ] = None,
-    prep: Annotated[
-        str | None, typer.Option(help="Preprocessing version (default: the only one).")
-    ] = None,
+    trials_: TrialsOption = None,
+    prep: PrepOption = None,
     warmup: Annotated[int, typer.Option(help="Cycles that train before scoring starts.")] = 10,
     change_at: Annotated[
         str | None,
@@ -677,10 +887,11 @@ def stream(
     """Prequential evaluation: per trial in time order, predict each cycle, score it, then
     learn it; report recovery after the change and Page-Hinkley drift alarms.
 
-    Rows go to table stream_cycles; a killed stream continues where it stopped.
-    Example: suds-exp simulate --out bed --gaits O --freqs 1 --repeats 4 --cycles 60
-    --effect medium_compaction=on@20s --ingest && suds-exp preprocess && suds-exp stream
-    bed --models GMR,OnlineGMR --plot reports/bed.png
+    Rows go to table stream_cycles; a killed stream continues where it stopped. A robot
+    that changes: simulate --effect medium_compaction=on@20s, then stream its trials.
+
+    Examples:
+      suds-exp stream s --models GMR,OnlineGMR --warmup 2 --plot reports/s.png
     """
     from suds_exp.commands.stream import print_stream, stream_command
 
@@ -701,29 +912,28 @@ def stream(
         print_stream(summary)
 
 
-gait_app = typer.Typer(
-    help="Gaits: predict a gait's motion, draw the learned connection, design and verify.",
-    no_args_is_help=True,
+gait_app = sub_app(
+    "Gaits: predict a gait's motion, draw the learned connection, design and verify."
 )
 app.add_typer(gait_app, name="gait")
-PrepOption = Annotated[
-    str | None, typer.Option(help="Preprocessing version (default: the only one).")
-]
-LearnerOption = Annotated[str, typer.Option(help="Learner name (see suds_exp.models).")]
 
 
-@command(on=gait_app, name="predict", flags={"frequency_hz": "--freq", "n_boot": "--boots"})
+@command(
+    on=gait_app,
+    name="predict",
+    flags={"frequency_hz": "--freqs", "n_boot": "--boots", "learner": "--model"},
+)
 def gait_predict(
     gait_file: Annotated[
         Path,
         typer.Option(help="CSV phase_rad,<joint>_rad,... or TOML; one column per actuated joint."),
     ],
-    freq: Annotated[str, typer.Option(help="Gait frequency, Hz (e.g. 1/2).")] = "0.5",
+    freqs: FreqOption = "1/2",
+    freq: FreqAlias = None,
     prep: PrepOption = None,
-    learner: LearnerOption = "GMR",
-    trials_: Annotated[
-        str | None, typer.Option("--trials", help="Training trial ids (default: all).")
-    ] = None,
+    model: ModelOption = "GMR",
+    learner: LearnerAlias = None,
+    trials_: TrialsOption = None,
     boots: Annotated[
         int, typer.Option(help="Bootstrap refits for the 95 % intervals: 0 (none) or 40+.")
     ] = 40,
@@ -736,19 +946,22 @@ def gait_predict(
     from a learner fitted on the version's trials, by the SE(2) path-ordered integral;
     warns when the gait leaves the data's support.
 
-    Example: suds-exp gait predict --gait-file ellipse.toml --freq 1/2 --learner GMR --json
+    --boots 40 or more gives 95 % intervals.
+
+    Examples:
+      suds-exp gait predict --gait-file ellipse.toml --freqs 1/2 --model GMR --boots 0 --json
     """
     from suds_exp.commands.gait import predict_command, predict_text
-    from suds_exp.commands.simulate import parse_freqs
+    from suds_exp.commands.simulate import parse_freq
     from suds_exp.robot import parse_ids
 
-    (frequency,) = parse_freqs(freq)[:1]
+    model = either(model, learner)
     doc = predict_command(
         open_store(db),
         gait_file,
-        frequency,
+        parse_freq(either(freqs, freq)),
         prep,
-        learner,
+        model,
         parse_ids(trials_),
         either(boots, boot),
         bound,
@@ -756,10 +969,10 @@ def gait_predict(
     if json_:
         console.print_json(doc)
     else:
-        console.out.print(predict_text(doc, learner))
+        console.out.print(predict_text(doc, model))
 
 
-@command(on=gait_app, name="design", flags={"frequency_hz": "--freq"})
+@command(on=gait_app, name="design", flags={"frequency_hz": "--freqs", "learner": "--model"})
 def gait_design(
     bound: Annotated[float, typer.Option(help="Joint bound |angle| <= RAD, every joint.")] = 1.3,
     iterations: Annotated[int, typer.Option(help="Design iterations.")] = 5,
@@ -767,8 +980,10 @@ def gait_design(
         bool, typer.Option("--verify", help="Run each design on the simulator and learn it.")
     ] = False,
     prep: PrepOption = None,
-    learner: LearnerOption = "GMR",
-    freq: Annotated[str, typer.Option(help="Gait frequency, Hz.")] = "0.5",
+    model: ModelOption = "GMR",
+    learner: LearnerAlias = None,
+    freqs: FreqOption = "1/2",
+    freq: FreqAlias = None,
     order: Annotated[int, typer.Option(help="Fourier harmonics per joint.")] = 2,
     out: Annotated[
         Path, typer.Option(help="Folder for verify trials, designed gaits and the report.")
@@ -781,18 +996,22 @@ def gait_design(
     region of the learned map; with --verify, the data-driven loop on the simulator.
 
     Every iteration is stored (table gait_design_iterations).
-    Example: suds-exp gait design --bound 1.3 --iterations 5 --verify --json
+    The designed gaits are Fourier TOML files under --out.
+
+    Examples:
+      suds-exp gait design --bound 1.3 --iterations 2 --json
+      suds-exp gait design --bound 1.3 --iterations 1 --verify
     """
     from suds_exp.commands.gait import design_command, iteration_text
-    from suds_exp.commands.simulate import build_config, parse_freqs
+    from suds_exp.commands.simulate import build_config, parse_freq
     from suds_exp.gait.design import DesignOptions
 
     options = DesignOptions(
-        learner=learner,
+        learner=either(model, learner),
         bound=bound,
         iterations=iterations,
         verify=verify,
-        frequency_hz=parse_freqs(freq)[0],
+        frequency_hz=parse_freq(either(freqs, freq)),
         order=order,
     )
 
@@ -806,15 +1025,16 @@ def gait_design(
         console.out.print(f"design {doc['design_id']} stored; report {doc['report']}")
 
 
-@command(on=gait_app, name="connection", flags={"half_range": "--range"})
+@command(on=gait_app, name="connection", flags={"half_range": "--range", "learner": "--model"})
 def gait_connection(
     out: Annotated[Path, typer.Option(help="CSV file; the figure goes beside it (.png).")] = Path(
         "reports/gait-connection/learned.csv"
     ),
     prep: PrepOption = None,
-    learner: LearnerOption = "GMR",
-    grid: Annotated[int, typer.Option(help="Points per joint axis.")] = 21,
-    range_: Annotated[float, typer.Option("--range", help="Half range of phi1, phi2 (rad).")] = 2.0,
+    model: ModelOption = "GMR",
+    learner: LearnerAlias = None,
+    grid: GridOption = 21,
+    range_: RangeOption = 2.0,
     compare: Annotated[
         bool, typer.Option("--compare", help="Beside the simulator's connection (locked).")
     ] = False,
@@ -835,7 +1055,11 @@ def gait_connection(
     """The learned local connection, its curl (height function) and support, drawn as
     sysplotter does; --compare adds the simulator's own and their normalised difference.
 
-    Example: suds-exp gait connection --out reports/learned.csv --compare
+    --gait-file overlays gaits on the figure.
+
+    Examples:
+      suds-exp gait connection --out reports/learned.csv --grid 11 --compare \\
+        --gait-file ellipse.toml
     """
     from suds_exp.commands.gait import connection_command, connection_lines
     from suds_exp.commands.simulate import build_config
@@ -844,7 +1068,7 @@ def gait_connection(
         open_store(db),
         out,
         prep,
-        learner,
+        either(model, learner),
         grid,
         range_,
         compare,
@@ -859,10 +1083,9 @@ def gait_connection(
         console.out.print(line)
 
 
-plan_app = typer.Typer(
-    help="Plan the next recording: which trial teaches the map most or improves the best "
-    "gait, and when more data stops helping; the closed loop on the simulator.",
-    no_args_is_help=True,
+plan_app = sub_app(
+    "Plan the next recording: which trial teaches the map most or improves the best "
+    "gait, and when more data stops helping; the closed loop on the simulator."
 )
 app.add_typer(plan_app, name="plan")
 GoalOption = Annotated[
@@ -873,19 +1096,23 @@ GoalOption = Annotated[
 @command(
     on=plan_app,
     name="next",
-    flags={"frequencies_hz": "--freqs", "gait_files": "--target", "n_boot": "--boots"},
+    flags={
+        "frequencies_hz": "--freqs",
+        "gait_files": "--target",
+        "n_boot": "--boots",
+        "learner": "--model",
+    },
 )
 def plan_next_cmd(
     goal: GoalOption = "map",
-    target: Annotated[
-        list[Path] | None, typer.Option(help="Target gait file (CSV or TOML); repeatable.")
-    ] = None,
-    freqs: Annotated[str | None, typer.Option(help="Target frequencies, Hz (default 1/2).")] = None,
+    target: TargetOption = None,
+    freqs: TargetFreqsOption = None,
     bound: Annotated[float, typer.Option(help="Joint bound of a designed gait, rad.")] = 1.3,
     n: Annotated[int, typer.Option(help="Trials to recommend (map goal).")] = 1,
     cycles: Annotated[int, typer.Option(help="Cycles per recommended trial.")] = 5,
     prep: PrepOption = None,
-    learner: LearnerOption = "GMR",
+    model: ModelOption = "GMR",
+    learner: LearnerAlias = None,
     out: Annotated[Path, typer.Option(help="Folder for a new gait's file.")] = Path("plan-next"),
     seed: Annotated[int, typer.Option(help="Seed of the bootstrap refits.")] = 0,
     boots: Annotated[int, typer.Option(help="Bootstrap refits for the uncertainty.")] = 6,
@@ -896,7 +1123,11 @@ def plan_next_cmd(
     the target's prediction variance, or expected improvement of the best gait), and say
     whether more data of this kind still helps (the learning curve).
 
-    Example: suds-exp plan next --goal gait --bound 1.3 --json
+    The map goal takes --target gait files and --freqs.
+
+    Examples:
+      suds-exp plan next --goal gait --bound 1.3 --json
+      suds-exp plan next --goal map --target ellipse.toml --freqs 1/2 --n 2
     """
     from suds_exp.commands.plan import next_command, next_lines
 
@@ -910,7 +1141,7 @@ def plan_next_cmd(
         n,
         cycles,
         out,
-        learner,
+        either(model, learner),
         seed,
         boots,
     )
@@ -924,7 +1155,7 @@ def plan_next_cmd(
 @command(
     on=plan_app,
     name="loop",
-    flags={"frequencies_hz": "--freqs", "target_files": "--target"},
+    flags={"frequencies_hz": "--freqs", "target_files": "--target", "learner": "--model"},
 )
 def plan_loop_cmd(
     goal: GoalOption = "gait",
@@ -934,12 +1165,11 @@ def plan_loop_cmd(
     ] = 50,
     seed: Annotated[int, typer.Option(help="Seed of the loop (trials and refits).")] = 0,
     cycles: Annotated[int, typer.Option(help="Cycles per planned trial.")] = 5,
-    target: Annotated[
-        list[Path] | None, typer.Option(help="Target gait file (CSV or TOML); repeatable.")
-    ] = None,
-    freqs: Annotated[str | None, typer.Option(help="Target frequencies, Hz (default 1/2).")] = None,
+    target: TargetOption = None,
+    freqs: TargetFreqsOption = None,
     prep: PrepOption = None,
-    learner: LearnerOption = "GMR",
+    model: ModelOption = "GMR",
+    learner: LearnerAlias = None,
     out: Annotated[Path, typer.Option(help="Folder for the loop's captures and gaits.")] = Path(
         "plan-loop"
     ),
@@ -952,12 +1182,14 @@ def plan_loop_cmd(
     preprocess it into the version, refit; every iteration stored (table plan_iterations).
     Starts from 5 cycles of O at 1/2 Hz when there is no version; run again to continue.
 
-    Example: suds-exp plan loop --goal gait --bound 1.3 --budget-cycles 50 --seed 1 --json
+    Examples:
+      suds-exp plan loop --goal gait --bound 1.3 --budget-cycles 10 --seed 1 --json
     """
     from suds_exp.commands.plan import iteration_line, loop_command, loop_lines, loop_options
     from suds_exp.commands.simulate import build_config
 
-    options = loop_options(goal, bound, budget_cycles, seed, cycles, learner, target, freqs)
+    model = either(model, learner)
+    options = loop_options(goal, bound, budget_cycles, seed, cycles, model, target, freqs)
     say = None if (json_ or quiet) else (lambda it: console.out.print(iteration_line(it)))
     doc = loop_command(
         open_store(db),

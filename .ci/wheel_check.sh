@@ -32,10 +32,21 @@ in_sdist = tarfile.open(sdist).getnames()
 for name in sql:
     assert f"suds_exp/migrations/{name}" in in_wheel, f"wheel lacks migration {name}"
     assert any(n.endswith(f"/migrations/{name}") for n in in_sdist), f"sdist lacks {name}"
-for data in ("suds_exp/body/swimmer.toml", "suds_exp/__main__.py", "cli.py"):
+for data in ("suds_exp/body/swimmer.toml", "suds_exp/__main__.py", "suds_exp/app/cli.py"):
     assert data in in_wheel, f"wheel lacks {data}"
 assert any(n.endswith(".dist-info/licenses/LICENSE") for n in in_wheel), "wheel lacks LICENSE"
-print(f"wheel: {len(in_wheel)} files, {len(sql)} migrations, swimmer.toml, LICENSE; sdist too")
+# cli.py goes in as suds_exp.app.cli: no generic top-level module in a user's site-packages,
+# and the folder mapped to suds_exp.app (the repository's top) holds no other module
+top = {n.split("/")[0] for n in in_wheel}
+assert top <= {"suds_exp"} | {t for t in top if t.endswith((".dist-info", ".data"))}, top
+app = [n for n in in_wheel if n.startswith("suds_exp/app/")]
+assert app == ["suds_exp/app/cli.py"], app
+meta = zipfile.ZipFile(wheel).read(next(n for n in in_wheel if n.endswith("/METADATA"))).decode()
+urls = {line.split(": ", 1)[1].split(", ")[0] for line in meta.splitlines()
+        if line.startswith("Project-URL: ")}
+assert {"Documentation", "Source", "Changelog"} <= urls, f"project URLs: {urls}"
+print(f"wheel: {len(in_wheel)} files, {len(sql)} migrations, swimmer.toml, LICENSE, "
+      f"cli as suds_exp/app/cli.py, URLs {sorted(urls)}; sdist too")
 EOF
 
 step "install the wheel into a fresh venv"
@@ -55,8 +66,10 @@ export PATH="$BIN:$PATH"
 
 step "the installed package is the one imported"
 python - <<'EOF'
-import sys, cli, suds_exp
+import importlib.util, sys, suds_exp
+import suds_exp.app.cli as cli
 from importlib.resources import files
+assert importlib.util.find_spec("cli") is None, "a top-level module cli is installed"
 for module in (suds_exp, cli):
     assert module.__file__.startswith(sys.prefix), f"{module.__name__} from {module.__file__}"
 print("imported from", suds_exp.__file__, "; migrations at", files("suds_exp.migrations"))

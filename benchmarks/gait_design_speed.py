@@ -46,10 +46,10 @@ from learner_speed import alternate  # noqa: E402  (rounds on an export of the b
 #: The design's options beside the learner and --verify (the default test's design).
 DESIGN = ["--bound", "1.3", "--iterations", "2", "--order", "1"]
 CASES = {
-    "GMR verify": ["--learner", "GMR", "--verify"],
-    "GMR": ["--learner", "GMR"],
-    "GMR+SUDS verify": ["--learner", "GMR+SUDS", "--verify"],
-    "GMR+SUDS": ["--learner", "GMR+SUDS"],
+    "GMR verify": ["--model", "GMR", "--verify"],
+    "GMR": ["--model", "GMR"],
+    "GMR+SUDS verify": ["--model", "GMR+SUDS", "--verify"],
+    "GMR+SUDS": ["--model", "GMR+SUDS"],
 }
 DEFAULT_CASES = ("GMR verify", "GMR", "GMR+SUDS verify")
 #: Timings, which differ run to run: left out of the digest.

@@ -116,7 +116,7 @@ def alternate(commit: str, rounds: int, run) -> tuple[list, list]:
 
 def _export(commit: str, folder: Path) -> None:
     data = subprocess.run(
-        ["git", "archive", commit, "suds_exp"], cwd=ROOT, check=True, capture_output=True
+        ["git", "archive", commit, "suds_exp", "cli.py"], cwd=ROOT, check=True, capture_output=True
     ).stdout
     with tarfile.open(fileobj=BytesIO(data)) as tar:
         tar.extractall(folder, filter="data")

@@ -44,3 +44,20 @@ def test_a_small_command_imports_no_heavy_library(db, args):
         check=True,
     )
     assert json.loads(out.stdout.splitlines()[-1]) == [], out.stdout
+
+
+@pytest.mark.parametrize(
+    "args",
+    [["trials"], ["trials", "--csv"], ["sql", "SELECT 1 AS one"], ["status", "c"]],
+    ids=" ".join,
+)
+def test_trials_sql_and_status_read_without_pandas_or_sqlalchemy(db, args):
+    """They read a few rows through DuckDB alone (`suds_exp.store.rows`)."""
+    probe = PROBE.format(heavy=("pandas", "sqlalchemy"))
+    out = subprocess.run(
+        [sys.executable, "-c", probe, json.dumps([*args, "--db", str(db)])],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert json.loads(out.stdout.splitlines()[-1]) == [], out.stdout

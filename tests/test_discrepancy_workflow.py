@@ -116,7 +116,7 @@ def test_user_errors_exit_2(inertia_db):
         ["--alpha", "2"],
         ["--prep", "nope"],
         ["--trials", "a,b"],
-        ["--model-effect", "warp_drive=3"],
+        ["--effect", "warp_drive=3"],
     ):
         res = runner.invoke(app, ["discrepancy", "--db", str(inertia_db), *args])
         assert res.exit_code == 2, (args, res.output)

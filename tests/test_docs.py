@@ -4,7 +4,11 @@ Every ```sh and ```python block of a page listed below is run in order, in a fre
 folder, unless the line before its fence is ``<!-- skip-test: why -->``. A shell block
 may hold ``suds-exp ...`` commands (run through typer's CliRunner, each must exit 0),
 ``export NAME=VALUE`` and comments; any other line fails the test, so a page cannot
-show a command the test silently ignores. Python blocks share one namespace per page.
+show a command the test silently ignores. Each Python block runs on its own in a fresh
+interpreter (in the page's folder, after the blocks before it), as a reader pasting it
+would run it: a block that needs an import from an earlier one fails. A page marked
+``<!-- executed -->`` is a notebook (docs/hooks/executed.py): its blocks share one
+namespace, as a notebook's cells do.
 """
 
 from __future__ import annotations
@@ -12,6 +16,8 @@ from __future__ import annotations
 import os
 import re
 import shlex
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -54,10 +60,24 @@ def run_page(page: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None
     monkeypatch.setenv("COLUMNS", "120")
     runner = CliRunner()
     namespace: dict = {"__name__": "__docs__"}
+    notebook = "<!-- executed -->" in (DOCS / page).read_text()
     ran = 0
     for lang, code in blocks(page):
-        if lang == "python":
+        if lang == "python" and notebook:
             exec(compile(code, f"{page} (python block)", "exec"), namespace)
+            ran += 1
+            continue
+        if lang == "python":
+            done = subprocess.run(
+                [sys.executable, "-c", code],
+                capture_output=True,
+                text=True,
+                env={**os.environ, "PYTHONPATH": str(DOCS.parent)},
+                timeout=600,
+            )
+            assert done.returncode == 0, (
+                f"{page}: a python block failed on its own:\n{code}\n{done.stderr}"
+            )
             ran += 1
             continue
         for argv in shell_commands(code):
@@ -80,7 +100,7 @@ def test_the_tutorial_runs(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize(
     "page",
-    ["how-to/own-recordings.md", "how-to/sql-and-pandas.md"],
+    ["how-to/own-recordings.md", "how-to/sql-and-pandas.md", "how-to/notebooks.md"],
 )
 def test_how_to_guides_run(page, tmp_path, monkeypatch):
     run_page(page, tmp_path, monkeypatch)

@@ -67,7 +67,7 @@ def test_the_simulator_reproduces_the_issue_figures():
 
 
 def _predict(db: Path, gait: Path, boot: str) -> dict:
-    args = ["--gait-file", str(gait), "--freq", "1/2", "--boot", boot, "--db", str(db)]
+    args = ["--gait-file", str(gait), "--freqs", "1/2", "--boots", boot, "--db", str(db)]
     return json.loads(ok("gait", "predict", *args, "--json"))
 
 
@@ -184,8 +184,8 @@ def test_design_without_verify_changes_no_trials(db, tmp_path):
 @pytest.mark.parametrize(
     "args",
     [
-        ["gait", "design", "--learner", "NoSuchLearner"],
-        ["gait", "predict", "--learner", "NoSuchLearner", "--gait-file", "G"],
+        ["gait", "design", "--model", "NoSuchLearner"],
+        ["gait", "predict", "--model", "NoSuchLearner", "--gait-file", "G"],
         ["gait", "design", "--bound", "-1"],
     ],
     ids=["design-learner", "predict-learner", "design-bound"],
@@ -199,7 +199,7 @@ def test_bad_options_are_one_line_and_leave_the_db_unchanged(db, tmp_path, args)
         app,
         [
             *args,
-            "--out" if args[1] == "design" else "--freq",
+            "--out" if args[1] == "design" else "--freqs",
             str(tmp_path / "o") if args[1] == "design" else "0.5",
             "--db",
             str(db),

@@ -36,7 +36,7 @@ def test_every_package_folder_is_listed_for_the_wheel():
     folders = {
         ".".join(p.parent.relative_to(REPO).parts) for p in (REPO / "suds_exp").rglob("__init__.py")
     }
-    assert listed == folders | {"suds_exp.migrations"}
+    assert listed == folders | {"suds_exp.migrations", "suds_exp.app"}
 
 
 def test_version_is_the_installed_metadata():

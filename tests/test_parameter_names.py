@@ -88,7 +88,7 @@ def test_the_library_speaks_python(tmp_path):
         (["preprocess", "--param", "k=99"], "--param k=99: must be between 1 and"),
         (["preprocess", "--preset", "papers"], "--preset papers: unknown preset;"),
         (["simulate", "--out", "x", "--freqs", "fast"], "--freqs 'fast': expected Hz values"),
-        (["discrepancy", "--model-effect", "flippers"], "--model-effect 'flippers': expected"),
+        (["discrepancy", "--effect", "flippers"], "--effect 'flippers': expected"),
     ],
 )
 def test_the_cli_shows_flags(tmp_path, args, says):

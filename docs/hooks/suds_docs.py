@@ -20,9 +20,11 @@ network (a MathJax page needs both).
 
 from __future__ import annotations
 
+import html
 import re
 import sys
 import tempfile
+import textwrap
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -69,10 +71,7 @@ def math_image(match: re.Match) -> str:
     with matplotlib.rc_context({"svg.hashsalt": "suds-docs", "svg.fonttype": "path"}):
         mathtext.math_to_image(f"${tex}$", buf, format="svg", dpi=110)
     data = base64.b64encode(buf.getvalue()).decode()
-    return (
-        f'<img class="math" alt="{html.escape(tex)}" '
-        f'src="data:image/svg+xml;base64,{data}">'
-    )
+    return f'<img class="math" alt="{html.escape(tex)}" src="data:image/svg+xml;base64,{data}">'
 
 
 # --- database --------------------------------------------------------------------------
@@ -244,7 +243,16 @@ def cli() -> str:
     done = CliRunner().invoke(typer.cli.app, args)
     if done.exit_code != 0:
         raise RuntimeError(f"typer's docs generator failed:\n{done.output}")
-    return re.sub(r"^(#+) ", r"#\1 ", done.stdout, flags=re.MULTILINE)
+    text = re.sub(r"^(#+) ", r"#\1 ", done.stdout, flags=re.MULTILINE)
+    return re.sub(r"^Examples:\n((?:  .*\n)+)", _examples, text, flags=re.MULTILINE)
+
+
+def _examples(match: re.Match) -> str:
+    # a help's `Examples:` paragraph (one command a line, `\` continues one) as a console
+    # block, as the help prints it, not as a Markdown paragraph that joins its lines
+    lines = html.unescape(textwrap.dedent(match.group(1))).splitlines()
+    shown = [line if line.startswith(" ") else f"$ {line}" for line in lines]
+    return "**Examples**:\n\n```console\n" + "\n".join(shown) + "\n```\n"
 
 
 GENERATORS = {

@@ -51,6 +51,7 @@ from suds_exp.campaign.grid import enumerate_draws
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
+from suds_exp.display import Summary
 from suds_exp.errors import CampaignError, ClusterLostError, StoreError
 from suds_exp.ingest import stored_design
 from suds_exp.progress import progress_bar
@@ -68,9 +69,10 @@ FLUSH_SECONDS = 10.0
 SCHEDULER_WAIT_S = 5.0
 
 
-@dataclass
-class RunSummary:
-    """What a call of `run_campaign` did."""
+@dataclass(repr=False)
+class RunSummary(Summary):
+    """What a call of `run_campaign` did; shown (repr, notebook) with the campaign's jobs
+    done and its best learner so far (lowest median RMSE of vx, read from ``db``)."""
 
     campaign: str
     total_jobs: int
@@ -83,6 +85,22 @@ class RunSummary:
     flush_seconds: float = 0.0
     created: bool = False
     extra: dict = field(default_factory=dict)
+    db: Path | None = None
+
+    def _summary(self):
+        done = self.total_jobs - self.remaining
+        fields = [
+            ("jobs done", f"{done} / {self.total_jobs}"),
+            ("this run", f"{self.done_now} jobs in {self.seconds:.1f} s"),
+        ]
+        if self.failed_now:
+            fields.append(("failed", self.failed_now))
+        if self.interrupted:
+            fields.append(("stopped", "run again to continue"))
+        best = best_learner(self.db, self.campaign) if self.db is not None else None
+        if best is not None:
+            fields.append(("best learner", f"{best[0]} (median RMSE vx {best[1]:.3g} mm/s)"))
+        return f"campaign {self.campaign}", fields
 
     @property
     def remaining(self) -> int:
@@ -116,6 +134,25 @@ class RunSummary:
             "seconds": self.seconds,
             "skipped_cells": self.extra.get("skipped_cells", []),
         }
+
+
+def best_learner(db: Path, campaign: str) -> tuple[str, float] | None:
+    """The learner of ``campaign`` with the lowest median RMSE of vx (mm/s) over its
+    finished jobs, and that median; None before any job (or when the file is busy)."""
+    from suds_exp.store.rows import read_rows
+
+    try:
+        rows = read_rows(
+            db,
+            "SELECT model, median(rmse_vx) AS m FROM results WHERE campaign = ? "
+            "AND error IS NULL GROUP BY model ORDER BY m NULLS LAST LIMIT 1",
+            [campaign],
+        )
+    except Exception:  # a display never raises: the line is left out
+        return None
+    if not rows.rows or rows.rows[0][1] is None:
+        return None
+    return rows.rows[0][0], float(rows.rows[0][1])
 
 
 def load_stored_definition(store: Store, name: str) -> dict | None:
@@ -282,7 +319,9 @@ def run_campaign(
                 + "); lower train_cycles/sweep",
                 param=("skip_infeasible", "train_cycles", "sweep"),
             )
-        summary = RunSummary(name, total, total - pending, created=stored is None)
+        summary = RunSummary(
+            name, total, total - pending, created=stored is None, db=Path(store.path)
+        )
         summary.extra["skipped_cells"] = plan.definition.get("skipped_cells", [])
         _record_start(store, plan, stored is None, total, backend, n_workers, pending)
         if pending:

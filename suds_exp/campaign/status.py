@@ -4,24 +4,28 @@ from __future__ import annotations
 
 import json
 from datetime import UTC, datetime
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from suds_exp.campaign.lock import run_holder
 from suds_exp.errors import CampaignError
-from suds_exp.ingest import stored_design
-from suds_exp.store import Store
+from suds_exp.ingest.experiment import read_design
+from suds_exp.store.rows import read_connection, text_literal
+
+if TYPE_CHECKING:  # status reads through DuckDB alone: a Store is only its path here
+    from suds_exp.store import Store
 
 
 def _read_status(raw, path, name: str):
     """The campaign's row (definition, number of jobs, version), results per model, the
     start of its last run and what it finished since."""
+    # the campaign's name as a literal, not a bound parameter: see text_literal
+    name_sql = text_literal(name)
     has = raw.execute(
         "SELECT count(*) FROM information_schema.tables WHERE table_name = 'campaigns'"
     ).fetchone()[0]
     row = (
         raw.execute(
-            "SELECT definition, n_jobs, prep_version FROM campaigns WHERE name = ?", [name]
+            f"SELECT definition, n_jobs, prep_version FROM campaigns WHERE name = {name_sql}"
         ).fetchone()
         if has
         else None
@@ -37,21 +41,22 @@ def _read_status(raw, path, name: str):
             step="run",
         )
     definition, total, prep = json.loads(row[0]), int(row[1]), row[2]
-    per_model = raw.execute(
-        "SELECT model, count(*) AS done, count(error) AS failed FROM results "
-        "WHERE campaign = ? GROUP BY model",
-        [name],
-    ).df()
+    per_model = {
+        model: (int(done), int(failed))
+        for model, done, failed in raw.execute(
+            "SELECT model, count(*) AS done, count(error) AS failed FROM results "
+            f"WHERE campaign = {name_sql} GROUP BY model"
+        ).fetchall()
+    }
     last_run = raw.execute(
-        "SELECT started_at FROM campaign_runs WHERE campaign = ? ORDER BY id DESC LIMIT 1",
-        [name],
+        f"SELECT started_at FROM campaign_runs WHERE campaign = {name_sql} ORDER BY id DESC LIMIT 1"
     ).fetchone()
     started = last_run[0] if last_run else None
     since = (
         raw.execute(
-            "SELECT count(*), max(finished_at) FROM results "
-            "WHERE campaign = ? AND finished_at >= ?",
-            [name, started],
+            f"SELECT count(*), max(finished_at) FROM results WHERE campaign = {name_sql} "
+            "AND finished_at >= (SELECT started_at FROM campaign_runs "
+            f"WHERE campaign = {name_sql} ORDER BY id DESC LIMIT 1)"
         ).fetchone()
         if started is not None
         else (0, None)
@@ -59,15 +64,14 @@ def _read_status(raw, path, name: str):
     return definition, total, prep, per_model, started, since
 
 
-def _model_table(models: list[str], total: int, per_model: pd.DataFrame) -> list[dict]:
+def _model_table(models: list[str], total: int, per_model: dict) -> list[dict]:
     per_job = total // max(len(models), 1)
-    counts = per_model.set_index("model") if len(per_model) else pd.DataFrame()
     return [
         {
             "model": m,
-            "done": int(counts.loc[m, "done"]) if m in counts.index else 0,
+            "done": per_model.get(m, (0, 0))[0],
             "total": per_job,
-            "failed": int(counts.loc[m, "failed"]) if m in counts.index else 0,
+            "failed": per_model.get(m, (0, 0))[1],
         }
         for m in models
     ]
@@ -86,10 +90,9 @@ def campaign_status(store: Store, name: str) -> dict:
     n_cycles, pairs}), ``experiment`` (the design stored with the data,
     `suds_exp.ingest.stored_design`: {source, axes: list of {name, kind, levels, added}}).
     """
-    with store.read() as conn:
-        definition, total, prep, per_model, started, since = _read_status(
-            conn.connection.driver_connection, store.path, name
-        )
+    with read_connection(store.path) as raw:
+        definition, total, prep, per_model, started, since = _read_status(raw, store.path, name)
+        design = read_design(raw)
     table = _model_table(list(definition["options"]["models"]), total, per_model)
     done = sum(r["done"] for r in table)
     holder = run_holder(store.path)
@@ -113,7 +116,7 @@ def campaign_status(store: Store, name: str) -> dict:
         "rate_jobs_per_s": rate,
         "eta_s": eta,
         "skipped_cells": definition.get("skipped_cells", []),
-        "experiment": design_document(stored_design(store)),
+        "experiment": design_document(design),
     }
 
 

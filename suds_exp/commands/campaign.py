@@ -11,8 +11,6 @@ import json
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-import pandas as pd
-
 from suds_exp import console
 from suds_exp.campaign.conditions import parse_int_list
 from suds_exp.errors import CampaignError
@@ -85,8 +83,12 @@ def parse_model_params(items: Sequence[str], names: Sequence[str]) -> dict[str, 
 
 def print_status(status: dict) -> None:
     """Print `campaign_status` as a per-learner table and one summary line."""
-    frame = pd.DataFrame(status["models"])
-    console.print_frame(frame, title=f"campaign {status['campaign']} (prep {status['prep']})")
+    from suds_exp.store.rows import Rows
+
+    models = status["models"]
+    columns = ("model", "done", "total", "failed")
+    table = Rows(columns, [tuple(m[c] for c in columns) for m in models])
+    console.print_rows(table, title=f"campaign {status['campaign']} (prep {status['prep']})")
     rate = status["rate_jobs_per_s"]
     line = f"{status['done']} / {status['total']} jobs done"
     if status["failed"]:

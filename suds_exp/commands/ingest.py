@@ -42,12 +42,23 @@ def print_ingest(results: list, as_json: bool = False) -> int:
     return len(failed)
 
 
-def print_trials(frame, as_json: bool = False) -> None:
-    """The trials of `list_trials` as a table (file names without their folders) or one
-    JSON list."""
+def print_trials(rows, as_json: bool = False, as_csv: bool = False) -> None:
+    """The trials of `suds_exp.store.rows.trial_rows` as a table (file names without their
+    folders), one JSON list or CSV (both with every column)."""
+    from suds_exp.store.rows import Rows
+
     if as_json:
-        console.print_json(frame)
-    else:
-        shown = frame.drop(columns=["source_file", "ingested_at"])
-        shown.insert(1, "file", frame.source_file.map(lambda p: Path(p).name))
-        console.print_frame(shown, title="trials")
+        console.print_json(rows)
+        return
+    if as_csv:
+        console.print_csv(rows)
+        return
+    keep = [c for c in rows.columns if c not in ("id", "source_file", "ingested_at")]
+    shown = Rows(
+        ("id", "file", *keep),
+        [
+            (r["id"], Path(r["source_file"]).name, *(r[c] for c in keep))
+            for r in (dict(zip(rows.columns, row, strict=True)) for row in rows.rows)
+        ],
+    )
+    console.print_rows(shown, title="trials")

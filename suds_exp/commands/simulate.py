@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from suds_exp import console
 from suds_exp.errors import ConfigError
 from suds_exp.robot import FREQUENCIES_HZ, GAITS, parse_frequency
 from suds_exp.sim.config import SimConfig, load_config
@@ -48,6 +49,17 @@ def parse_freqs(text: str | None) -> tuple[float, ...]:
             param="frequencies_hz",
         )
     return freqs
+
+
+def parse_freq(text: str) -> float:
+    """``"1/2"`` -> 0.5 Hz: one frequency (a gait's); a list is refused."""
+    freqs = parse_freqs(text)
+    if len(freqs) != 1:
+        raise ConfigError(
+            f"frequency_hz {text!r}: expected one frequency in Hz, such as 1/2",
+            param="frequency_hz",
+        )
+    return freqs[0]
 
 
 def parse_cycles(text: str | None) -> tuple[int, int]:
@@ -181,6 +193,18 @@ def effects_table(config: SimConfig | None = None) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def say_if_compiling() -> None:
+    """On stderr, before a first simulation after an install: the kernels compile once."""
+    from suds_exp.sim.precompile import COMPILE_S, kernels_cached
+
+    if not kernels_cached():
+        console.err.print(
+            f"compiling the simulator once (numba): about {COMPILE_S} s on an idle core, "
+            "more on a busy one; later runs load it from the cache",
+            highlight=False,
+        )
+
+
 def simulate_options(
     out: Path,
     config_path: Path | None = None,
@@ -197,6 +221,8 @@ def simulate_options(
     """`suds-exp simulate` from its option strings: the paper's design (`simulate_command`)
     or, with ``gait_file``, trials of that gait (`simulate_file_command`); ingested into
     ``store`` when one is given. A JSON-ready summary."""
+    if progress:
+        say_if_compiling()
     if gait_file is not None:
         return _simulate_gait_file(
             out,

@@ -16,12 +16,14 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-
-import sqlalchemy as sa
+from typing import TYPE_CHECKING
 
 from suds_exp.errors import IngestError
 from suds_exp.experiment import FREQUENCY_AXIS, PAPER_DESIGN, Axis, ExperimentDesign, is_paper
 from suds_exp.experiment.design import level_problem
+
+if TYPE_CHECKING:  # `suds-exp status` reads the design without loading SQLAlchemy
+    import sqlalchemy as sa
 
 #: ``experiment_description.source`` of the paper's design, stored when code adds levels
 #: to a database ingested with the default design.
@@ -32,29 +34,29 @@ def stored_design(store) -> ExperimentDesign:
     """The design stored with the data in ``store``: the user's description given at
     ingest with the levels added since, or `PAPER_DESIGN` when none was stored (a paper
     database with added levels returns the paper's design with them)."""
-    with store.read() as conn:
+    from suds_exp.store.rows import read_connection
+
+    with read_connection(store.path) as conn:
         return read_design(conn)
 
 
-def read_design(conn: sa.Connection) -> ExperimentDesign:
-    """`stored_design` on an open connection (read-only is enough)."""
-    tables = {
-        r[0] for r in conn.exec_driver_sql("SELECT table_name FROM duckdb_tables()").fetchall()
-    }
+def read_design(conn) -> ExperimentDesign:
+    """`stored_design` on an open connection (read-only is enough): a SQLAlchemy one or
+    DuckDB's own."""
+    sql = getattr(conn, "exec_driver_sql", None) or conn.execute
+    tables = {r[0] for r in sql("SELECT table_name FROM duckdb_tables()").fetchall()}
     if "experiment_axes" not in tables:  # a database older than migration 020
         return PAPER_DESIGN
     source = None
     if "experiment_description" in tables:
-        row = conn.exec_driver_sql("SELECT source FROM experiment_description").fetchone()
+        row = sql("SELECT source FROM experiment_description").fetchone()
         source = row[0] if row else None
-    axes = conn.exec_driver_sql(
-        "SELECT axis, kind FROM experiment_axes ORDER BY position"
-    ).fetchall()
+    axes = sql("SELECT axis, kind FROM experiment_axes ORDER BY position").fetchall()
     if source is None and not axes:
         return PAPER_DESIGN
     added_col = "added_by" if "experiment_description" in tables else "NULL"
     levels: dict[str, tuple[list[str], list[str]]] = {}
-    for axis, level, added in conn.exec_driver_sql(
+    for axis, level, added in sql(
         f"SELECT axis, level, {added_col} FROM experiment_levels ORDER BY axis, position"
     ).fetchall():
         levels.setdefault(axis, ([], []))[0 if added is None else 1].append(level)

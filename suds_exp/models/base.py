@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 from sklearn.base import BaseEstimator
 
+from suds_exp.display import Summary
 from suds_exp.errors import ConfigError, ModelError
 from suds_exp.robot import RA_COLUMNS, VB_COLUMNS
 
@@ -231,15 +232,40 @@ def check_choice(name: str, value, choices, model: str):
     return value
 
 
-class Learner(BaseEstimator):
+class Learner(Summary, BaseEstimator):
     """Common face of the learners: `fit(samples) -> self`, `predict(samples) -> DataFrame`.
 
     Subclasses set `name` (the learner name of `make_model`) and `suds` (whether the
-    learner models r_p and predicts dr_p/dt).
+    learner models r_p and predicts dr_p/dt). A learner shows itself under that name, with
+    the parameters it changes from its defaults and whether it is fitted
+    (``GMR+SUDS(n_components=8) [fitted: 6 inputs]``; in a notebook, a table of all).
     """
 
     name = "learner"
     suds = False
+
+    def _state(self) -> str:
+        n = getattr(self, "n_features_in_", None)
+        return "not fitted" if n is None else f"fitted: {n} inputs"
+
+    def _changed_params(self) -> dict:
+        try:
+            defaults = type(self)().get_params(deep=False)
+        except TypeError:  # a learner without defaults for every parameter
+            defaults = {}
+        return {
+            k: v
+            for k, v in self.get_params(deep=False).items()
+            if k not in defaults or repr(defaults[k]) != repr(v)
+        }
+
+    def _summary(self):
+        fields = [("state", self._state()), ("SUDS", "yes" if self.suds else "no")]
+        return self.name, fields + sorted(self.get_params(deep=False).items())
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self._changed_params().items())
+        return f"{self.name}({args}) [{self._state()}]"
 
     def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         """`predict`'s numbers as an array (n_samples, n_outputs): vx, vy (mm/s), wz

@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 
+from suds_exp.display import Summary
 from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.params import actuated_dimension, params_json
 from suds_exp.preprocess.phaser import Phaser
@@ -32,8 +33,8 @@ if TYPE_CHECKING:  # the run's result type; the pipeline imports this module
     from suds_exp.preprocess.pipeline import PrepResult
 
 
-@dataclass
-class Version:
+@dataclass(repr=False)
+class Version(Summary):
     """A preprocessing version: its identity, parameters and fitted state.
 
     Attributes
@@ -59,6 +60,18 @@ class Version:
     k: int
     pca: PassivePCA | None = None
     phasers: dict[str, Phaser] = field(default_factory=dict, repr=False)
+
+    def _summary(self):
+        from suds_exp.preprocess.params import DEFAULTS
+
+        changed = {k: v for k, v in self.params.items() if k not in DEFAULTS or DEFAULTS[k] != v}
+        return f"Version {self.id} {self.name!r}", [
+            ("parameters", f"{self.params_hash[:12]}; changed from the defaults: "
+             + (", ".join(f"{k}={v}" for k, v in changed.items()) or "none")),
+            ("passive components", self.k),
+            ("fitted", "yes" if self.pca is not None else "not yet"),
+            ("trial groups", len(self.phasers)),
+        ]  # fmt: skip
 
     def differentiator(self) -> Differentiator:
         """The version's differentiator: what made its rates (dr_a/dt, dr_p/dt, v_b)."""

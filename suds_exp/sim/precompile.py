@@ -38,6 +38,25 @@ def compile_kernels() -> float:
     return time.perf_counter() - t0
 
 
+#: what the first compile takes, in seconds on an idle core (compile_kernels, measured when
+#: this module was written; a loaded machine takes longer)
+COMPILE_S = 15
+
+
+def kernels_cached() -> bool:
+    """Whether numba's on-disk cache holds the simulator's main kernel for the installed
+    source, so a simulation starts without compiling. Reads the kernel's cache index
+    only (numba's own check: the source file's stamp and numba's version); True when the
+    cache cannot be asked, so that nothing is announced that may not happen."""
+    from suds_exp.sim import rft
+
+    try:
+        cache = rft.run_trials._cache
+        return bool(cache._cache_file._load_index())
+    except Exception:  # numba's cache layout is internal: assume cached
+        return True
+
+
 def main() -> int:
     print(f"simulator kernels compiled and cached in {compile_kernels():.1f} s")
     return 0

@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 import duckdb
-import sqlalchemy as sa
-from sqlalchemy.pool import NullPool
 
 from suds_exp.errors import StoreError
 from suds_exp.store.integrity import check_file
@@ -32,6 +31,9 @@ LOCK_WAIT_S = 15.0
 
 T = TypeVar("T")
 
+if TYPE_CHECKING:
+    import sqlalchemy as sa
+
 
 def default_db_path() -> Path:
     """The database path used when none is given: ``$SUDS_DB`` or ``./suds.duckdb``."""
@@ -40,6 +42,9 @@ def default_db_path() -> Path:
 
 def make_engine(path: Path, read_only: bool = False) -> sa.Engine:
     """A SQLAlchemy engine on the DuckDB file ``path`` that never pools connections."""
+    import sqlalchemy as sa
+    from sqlalchemy.pool import NullPool
+
     connect_args: dict = {"read_only": read_only}
     if not read_only:
         connect_args["config"] = {"storage_compatibility_version": STORAGE_VERSION}
@@ -100,6 +105,13 @@ def open_problem(exc: BaseException, path: Path) -> StoreError | None:
     return StoreError(f"{path}: cannot open the database: {text.splitlines()[0]}")
 
 
+def _open_errors() -> tuple[type[BaseException], ...]:
+    # SQLAlchemy wraps DuckDB's errors when a `Store` opens the file; a plain DuckDB
+    # connection (`suds_exp.store.rows`) raises them bare, and never loads SQLAlchemy
+    sa = sys.modules.get("sqlalchemy")
+    return (duckdb.IOException,) if sa is None else (duckdb.IOException, sa.exc.DBAPIError)
+
+
 def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAIT_S) -> T:
     """Call ``open_fn`` until it stops failing on a file lock, for at most ``wait_s`` s.
 
@@ -111,7 +123,7 @@ def retry_on_lock(open_fn: Callable[[], T], path: Path, wait_s: float = LOCK_WAI
     while True:
         try:
             return open_fn()
-        except (duckdb.IOException, sa.exc.DBAPIError) as exc:
+        except _open_errors() as exc:
             if not is_lock_error(exc):
                 problem = open_problem(exc, path)
                 if problem is None:

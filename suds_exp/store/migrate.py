@@ -21,11 +21,14 @@ from dataclasses import dataclass
 from importlib import resources
 from importlib.resources.abc import Traversable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import duckdb
-import sqlalchemy as sa
 
 from suds_exp.errors import StoreError
+
+if TYPE_CHECKING:  # a reader checks the migrations without loading SQLAlchemy
+    import sqlalchemy as sa
 
 #: The package whose data files are the migrations (the repository's ``migrations/``).
 MIGRATIONS_PACKAGE = "suds_exp.migrations"
@@ -143,6 +146,8 @@ def apply_on(
     conn: sa.Connection, migrations: list[Migration], target: int | None = None
 ) -> list[str]:
     """`apply` on an open connection outside a transaction (left outside one)."""
+    import sqlalchemy as sa
+
     migrations = [m for m in migrations if target is None or m.version <= target]
     with conn.begin():
         todo = pending(conn, migrations)

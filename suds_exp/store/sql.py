@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import json
-import math
-from typing import Any
 
 import duckdb
 import pandas as pd
 import sqlalchemy as sa
 
-from suds_exp.errors import StoreError
+from suds_exp.store.rows import plain as _plain
+from suds_exp.store.rows import query_problem
 from suds_exp.store.store import Store
 
 
@@ -19,22 +18,7 @@ def run_readonly(store: Store, query: str) -> pd.DataFrame:
     try:
         return store.query_df(query)
     except (duckdb.Error, sa.exc.DBAPIError) as exc:
-        text = str(exc).strip().splitlines()[0]
-        if "read-only" in text or "read only" in text:
-            raise StoreError(
-                "refused: this statement would change the database; queries here are read-only"
-            ) from None
-        raise StoreError(f"query failed: {text}") from None
-
-
-def _plain(value: Any) -> Any:
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    if hasattr(value, "isoformat"):
-        return value.isoformat()
-    return value
+        raise query_problem(exc) from None
 
 
 def frame_to_json(frame: pd.DataFrame) -> str:

@@ -8,22 +8,25 @@ import threading
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import duckdb
-import pandas as pd
-import sqlalchemy as sa
 
+from suds_exp.display import Summary
 from suds_exp.errors import StoreError
 from suds_exp.store import migrate
 from suds_exp.store.engine import default_db_path, make_engine, open_problem, retry_on_lock
 from suds_exp.store.integrity import mark_written
 from suds_exp.store.lock import WriteLock
 
+if TYPE_CHECKING:  # loaded when a block opens the file: a Store is made without them
+    import pandas as pd
+    import sqlalchemy as sa
+
 _frame_names = itertools.count()
 
 
-class Store:
+class Store(Summary):
     """A DuckDB database file, opened only for the length of each block.
 
     ``with store.write() as conn`` gives a SQLAlchemy connection inside one transaction
@@ -43,8 +46,11 @@ class Store:
         self.path = Path(path) if path is not None else default_db_path()
         self._migrated = False
 
-    def __repr__(self) -> str:
-        return f"Store({str(self.path)!r})"
+    def _summary(self):
+        from suds_exp.store.rows import contents
+
+        size = self.path.stat().st_size / 1e6 if self.path.exists() else 0.0
+        return f"Store {self.path}", [("size", f"{size:.1f} MB"), ("holds", contents(self.path))]
 
     # -- connections ---------------------------------------------------------------
     def locked(self, command: str, name: str | None = None, wait_s: float | None = None):
@@ -110,8 +116,12 @@ class Store:
         try:
             with self._connect(read_only=False) as conn:
                 yield conn
-        except (duckdb.Error, sa.exc.DBAPIError) as exc:
-            raise _write_problem(exc, self.path) from None
+        except Exception as exc:
+            import sqlalchemy as sa  # loaded by now: the block's engine is SQLAlchemy's
+
+            if isinstance(exc, duckdb.Error | sa.exc.DBAPIError):
+                raise _write_problem(exc, self.path) from None
+            raise
         finally:
             mark_written(self.path)
 
@@ -157,6 +167,8 @@ class Store:
         ``query`` is a SQLAlchemy Core statement (its bound parameters are used) or SQL
         text with DuckDB parameters (``?`` / ``$1`` / ``$name``) given in ``params``.
         """
+        import sqlalchemy as sa
+
         raw = conn.connection.driver_connection
         if isinstance(query, sa.sql.ClauseElement):
             compiled = query.compile(dialect=conn.dialect)
