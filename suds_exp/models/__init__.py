@@ -14,6 +14,10 @@ Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(s
 `OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
 `GradualGMR+SUDS` (`gradual.GradualGMRSuds`: GMR that adds passive coordinates online).
 
+Momentum learners (`MOMENTUM_MODELS`, the paper's Future Work): `GMR+P` and
+`GMR+SUDS+P` (`momentum.GMRMomentum`, `momentum.GMRSudsMomentum`), body velocity relaxing
+to a learned quasi-static GMR map with learned time constants.
+
 Beyond the paper (`sklearn_adapter.py`): `MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each
 also `+SUDS`) and `sklearn:ClassName` / `sklearn:pkg.mod.Class` (any regressor, `+SUDS`
 for GMR+SUDS's inputs); `model_recipe(model)` is what a campaign stores to rebuild one.
@@ -30,9 +34,15 @@ from suds_exp.errors import ConfigError
 from suds_exp.models.base import Learner, ModelError
 from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.gradual import GradualGMRSuds
+from suds_exp.models.momentum import GMRMomentum, GMRSudsMomentum
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
-from suds_exp.models.registry import BASELINE_LEARNERS, LEARNERS, ONLINE_LEARNERS
+from suds_exp.models.registry import (
+    BASELINE_LEARNERS,
+    LEARNERS,
+    MOMENTUM_LEARNERS,
+    ONLINE_LEARNERS,
+)
 from suds_exp.models.sklearn_adapter import SklearnLearner, make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
 
@@ -45,6 +55,10 @@ MODEL_NAMES = LEARNERS
 ONLINE_MODELS: dict[str, type[Learner]] = dict(
     zip(ONLINE_LEARNERS, (OnlineGMR, OnlineGMRSuds, GradualGMRSuds), strict=True)
 )
+#: Learners with a momentum state (`momentum.py`).
+MOMENTUM_MODELS: dict[str, type[Learner]] = dict(
+    zip(MOMENTUM_LEARNERS, (GMRMomentum, GMRSudsMomentum), strict=True)
+)
 #: The survey's named baselines (scikit-learn regressors with documented defaults).
 BASELINE_NAMES = BASELINE_LEARNERS
 
@@ -56,15 +70,16 @@ def make_model(name: str, **params) -> Learner:
     `sklearn_adapter`). Unknown names or parameters raise ConfigError; parameter values are
     checked by `fit` (by scikit-learn's own checks here for the adapter).
     """
-    adapter = make_adapter(name, params) if name not in MODELS else None
+    builders = {**MODELS, **ONLINE_MODELS, **MOMENTUM_MODELS}
+    adapter = make_adapter(name, params) if name not in builders else None
     if adapter is not None:
         return adapter
     try:
-        cls = MODELS[name] if name in MODELS else ONLINE_MODELS[name]
+        cls = builders[name]
     except KeyError:
         raise ConfigError(
             f"unknown model {name!r}; expected one of "
-            f"{', '.join(MODEL_NAMES + tuple(ONLINE_MODELS) + BASELINE_NAMES)}"
+            f"{', '.join((*builders, *BASELINE_NAMES))}"
             " or sklearn:ClassName"
         ) from None
     valid = _param_names(cls)
@@ -103,6 +118,9 @@ __all__ = [
     "OnlineGMRSuds",
     "GradualGMRSuds",
     "ModelError",
+    "MOMENTUM_MODELS",
+    "GMRMomentum",
+    "GMRSudsMomentum",
     "make_model",
     "GMR",
     "GMRSuds",
