@@ -8,7 +8,7 @@ import pytest
 from sklearn.base import clone
 
 from suds_exp.errors import ConfigError, SudsError
-from suds_exp.models import MODEL_NAMES, ModelError, make_model
+from suds_exp.models import MODEL_NAMES, MOMENTUM_MODELS, ModelError, make_model
 from suds_exp.testing.synthetic_swimmer import make_samples
 
 VARIANTS = [(name, {}) for name in MODEL_NAMES] + [
@@ -17,6 +17,8 @@ VARIANTS = [(name, {}) for name in MODEL_NAMES] + [
     ("GMR", {"branching": "filter"}),
     ("GMR", {"branching": "history"}),
     ("GMR", {"augment": "dilation"}),
+    *((name, {}) for name in MOMENTUM_MODELS),
+    ("GMR+SUDS+P", {"mode": "rollout"}),
 ]
 IDS = [n + "".join(f"-{v}" for v in p.values()) for n, p in VARIANTS]
 
@@ -125,7 +127,7 @@ def test_a_gap_inside_a_trial_restarts_the_series(data):
         np.testing.assert_allclose(m.predict(cut), m.predict(as_two), rtol=1e-9, atol=1e-9)
 
 
-@pytest.mark.parametrize("name", MODEL_NAMES)
+@pytest.mark.parametrize("name", [*MODEL_NAMES, *MOMENTUM_MODELS])
 def test_every_hyper_parameter_lands_in_its_own_attribute(name):
     """Subclasses forward their parameters positionally; a swapped pair would go unseen
     by the round-trip test, so set each to a distinct marker and read it back."""

@@ -103,10 +103,30 @@ class _Momentum:
         check_float("tau_max", self.tau_max, 0.0, n, strict=True)
         check_float("momentum_ridge", self.momentum_ridge, 0.0, n)
         check_float("lag_min_gain", self.lag_min_gain, 0.0, n)
+        self._fixed_tau()
         if self.lag_min_gain >= 1:
             raise ConfigError(
                 f"{n}: lag_min_gain={self.lag_min_gain!r}; expected a number in [0, 1)"
             )
+
+    def _fixed_tau(self) -> np.ndarray | None:
+        """The given time constants (3,) in s, or None when they are to be estimated."""
+        if self.tau is None:
+            return None
+        value = self.tau
+        values = list(value) if isinstance(value, tuple | list) else [value] * MAX_MOMENTUM
+        ok = len(values) == MAX_MOMENTUM and all(
+            isinstance(v, int | float | np.floating | np.integer)
+            and not isinstance(v, bool)
+            and 0 <= v < np.inf
+            for v in values
+        )
+        if not ok:
+            raise ConfigError(
+                f"{self.name}: tau={value!r}; expected None (estimate), a time constant "
+                "in s >= 0, or one for each of vx, vy, wz"
+            )
+        return np.array(values, dtype=float)
 
     # -- features --------------------------------------------------------------------
     def _design(self, samples, inputs=None):
@@ -175,10 +195,11 @@ class _Momentum:
         dt = float(np.median(steps)) if steps.size else 0.0
         lo = max(dt, 1e-3)
         grid = np.concatenate([[0.0], np.geomspace(lo, max(self.tau_max, lo), _TAU_GRID)])
-        fits = [solve(tau) for tau in grid]
-        errors = np.array([e for _, e in fits])  # (n_grid, 3)
+        fixed = self._fixed_tau()
+        if fixed is None:
+            errors = np.array([solve(tau)[1] for tau in grid])  # (n_grid, 3)
         tau = np.zeros(MAX_MOMENTUM)
-        for j in range(MAX_MOMENTUM):
+        for j in range(MAX_MOMENTUM if fixed is None else 0):
             i = int(np.argmin(errors[:, j]))
             if i == 0:
                 continue
@@ -197,6 +218,8 @@ class _Momentum:
             gain = 1.0 - err / errors[0, j]
             if len(v) * np.log(errors[0, j] / err) > np.log(len(v)) and gain >= self.lag_min_gain:
                 tau[j] = value
+        if fixed is not None:
+            tau = fixed.copy()
         # components beyond n_momentum (those with the shortest lags) are quasi-static
         keep = np.argsort(-tau, kind="stable")[: self.n_momentum]
         tau[np.setdiff1d(np.arange(MAX_MOMENTUM), keep)] = 0.0
@@ -257,6 +280,12 @@ class GMRMomentum(_Momentum, GMR):
     lag_min_gain : float in [0, 1), default 0.1
         Fraction of a component's training mean squared error a lag must remove to be
         kept.
+    tau : None, float or three floats, default None
+        None: the time constants are estimated from the training samples. A number (s)
+        or one per vx, vy, wz: fixed, e.g. the estimate of `momentum_information` on
+        data at several speeds. A strictly periodic gait at one speed cannot tell a lag
+        from a different quasi-static map (a lag of a periodic signal is another
+        periodic signal), so a training set of one condition rarely identifies tau.
 
     Attributes (besides GMR's): ``tau_`` (3,) time constants of vx, vy, wz in s (0: no
     lag); ``n_momentum_`` the momentum dimension the data chose; ``momentum_coef_``
@@ -288,6 +317,7 @@ class GMRMomentum(_Momentum, GMR):
         tau_max: float = 2.0,
         momentum_ridge: float = 1e-3,
         lag_min_gain: float = 0.1,
+        tau=None,
     ):
         super().__init__(
             n_components,
@@ -311,6 +341,7 @@ class GMRMomentum(_Momentum, GMR):
         self.tau_max = tau_max
         self.momentum_ridge = momentum_ridge
         self.lag_min_gain = lag_min_gain
+        self.tau = tau
 
     def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         self._check_fitted()
@@ -348,6 +379,7 @@ class GMRSudsMomentum(_Momentum, GMRSuds):
         tau_max: float = 2.0,
         momentum_ridge: float = 1e-3,
         lag_min_gain: float = 0.1,
+        tau=None,
     ):
         super().__init__(
             n_components,
@@ -372,6 +404,7 @@ class GMRSudsMomentum(_Momentum, GMRSuds):
         self.tau_max = tau_max
         self.momentum_ridge = momentum_ridge
         self.lag_min_gain = lag_min_gain
+        self.tau = tau
 
     def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         out = super().predict_array(samples)  # checks; dr_p/dt (and r_p) of GMR+SUDS
