@@ -7,6 +7,7 @@ import pytest
 from suds_exp.commands.campaign import parse_campaign_options
 from suds_exp.models import BASELINE_NAMES, MODEL_NAMES, ONLINE_MODELS, make_model
 from suds_exp.models.registry import (
+    FINSLER_LEARNERS,
     LEARNERS,
     MOMENTUM_LEARNERS,
     REGISTRY,
@@ -89,9 +90,9 @@ def test_the_labels_of_every_learner_name_are_as_before(tmp_path):
     )
     assert sorted(frame.model) == sorted(names)
     for row in frame.itertuples(index=False):
-        # the momentum learners came after migration 004: SUDS by the table, not the
+        # the momentum and Finsler learners came after migration 004: SUDS by the table, not the
         # paper's GMR (their own family in the GLM's terms)
-        new = row.model in MOMENTUM_LEARNERS
+        new = row.model in MOMENTUM_LEARNERS + FINSLER_LEARNERS
         assert bool(row.suds) == (SUDS_SUFFIX in row.model if new else row.model.endswith("+SUDS"))
         assert bool(row.gmr) == (row.model.startswith("GMR") and not new), row
         assert bool(row.phase_only) == (row.model == "phase-only"), row

@@ -18,6 +18,9 @@ Momentum learners (`MOMENTUM_MODELS`, the paper's Future Work): `GMR+P` and
 `GMR+SUDS+P` (`momentum.GMRMomentum`, `momentum.GMRSudsMomentum`), body velocity relaxing
 to a learned quasi-static GMR map with learned time constants.
 
+`GMR+F` (`finsler.GMRFinsler`, `FINSLER_MODELS`): GMR on the positive and negative parts
+of each shape velocity, a map homogeneous but not linear in it (Finsler contact).
+
 Beyond the paper (`sklearn_adapter.py`): `MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each
 also `+SUDS`) and `sklearn:ClassName` / `sklearn:pkg.mod.Class` (any regressor, `+SUDS`
 for GMR+SUDS's inputs); `model_recipe(model)` is what a campaign stores to rebuild one.
@@ -32,6 +35,7 @@ from functools import cache
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.finsler import GMRFinsler
 from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.momentum import GMRMomentum, GMRSudsMomentum
@@ -39,6 +43,7 @@ from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
 from suds_exp.models.registry import (
     BASELINE_LEARNERS,
+    FINSLER_LEARNERS,
     LEARNERS,
     MOMENTUM_LEARNERS,
     ONLINE_LEARNERS,
@@ -59,6 +64,8 @@ ONLINE_MODELS: dict[str, type[Learner]] = dict(
 MOMENTUM_MODELS: dict[str, type[Learner]] = dict(
     zip(MOMENTUM_LEARNERS, (GMRMomentum, GMRSudsMomentum), strict=True)
 )
+#: Learners whose map is homogeneous but not linear in the shape velocity (`finsler.py`).
+FINSLER_MODELS: dict[str, type[Learner]] = dict(zip(FINSLER_LEARNERS, (GMRFinsler,), strict=True))
 #: The survey's named baselines (scikit-learn regressors with documented defaults).
 BASELINE_NAMES = BASELINE_LEARNERS
 
@@ -70,7 +77,7 @@ def make_model(name: str, **params) -> Learner:
     `sklearn_adapter`). Unknown names or parameters raise ConfigError; parameter values are
     checked by `fit` (by scikit-learn's own checks here for the adapter).
     """
-    builders = {**MODELS, **ONLINE_MODELS, **MOMENTUM_MODELS}
+    builders = {**MODELS, **ONLINE_MODELS, **MOMENTUM_MODELS, **FINSLER_MODELS}
     adapter = make_adapter(name, params) if name not in builders else None
     if adapter is not None:
         return adapter
@@ -121,6 +128,8 @@ __all__ = [
     "MOMENTUM_MODELS",
     "GMRMomentum",
     "GMRSudsMomentum",
+    "FINSLER_MODELS",
+    "GMRFinsler",
     "make_model",
     "GMR",
     "GMRSuds",

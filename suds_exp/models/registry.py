@@ -17,6 +17,8 @@ from dataclasses import dataclass
 SUDS_SUFFIX = "+SUDS"
 #: The suffix of a learner with a momentum state: ``GMR+P``, ``GMR+SUDS+P``.
 MOMENTUM_SUFFIX = "+P"
+#: The suffix of a learner whose map is not linear in the shape velocity: ``GMR+F``.
+FINSLER_SUFFIX = "+F"
 #: Tags: the paper's five; ``models="survey"`` of a campaign; ``partial_fit``; the
 #: scikit-learn baselines of `sklearn_adapter.BASELINES`.
 TAGS = ("paper", "survey", "online", "baseline")
@@ -63,6 +65,8 @@ REGISTRY: tuple[LearnerInfo, ...] = (
     # the paper's Future Work: a low-dimensional momentum state (models/momentum.py)
     _learner("GMR", False, name="GMR" + MOMENTUM_SUFFIX),
     _learner("GMR", True, name="GMR" + SUDS_SUFFIX + MOMENTUM_SUFFIX),
+    # and a map homogeneous but not linear in the shape velocity (models/finsler.py)
+    _learner("GMR", False, name="GMR" + FINSLER_SUFFIX),
 )
 BY_NAME = {info.name: info for info in REGISTRY}
 
@@ -84,5 +88,7 @@ ONLINE_LEARNERS = tagged("online")
 BASELINE_LEARNERS = tagged("baseline")
 #: Learners with a momentum state (`models.momentum`): untagged, in `REGISTRY` order.
 MOMENTUM_LEARNERS = tuple(i.name for i in REGISTRY if i.name.endswith(MOMENTUM_SUFFIX))
+#: Learners whose map is homogeneous but not linear in the shape velocity.
+FINSLER_LEARNERS = tuple(i.name for i in REGISTRY if i.name.endswith(FINSLER_SUFFIX))
 #: The paper's five by role, for code that compares them (findings, synthetic results).
 PHASE_ONLY, TLS, TLS_SUDS, GMR, GMR_SUDS = LEARNERS
