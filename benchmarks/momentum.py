@@ -33,6 +33,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from suds_exp.analysis.formatting import to_markdown
+
 N_BOOT = 2000
 
 
@@ -98,8 +100,11 @@ def summary(results: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
         boot = np.median(a[idx], axis=1) / np.median(b[idx], axis=1)
         lo, hi = np.percentile(boot, [2.5, 97.5])
         ratios.append(
-            {"learner": model, "vx ratio to GMR": f"{np.median(a) / np.median(b):.2f}",
-             "95% interval": f"[{lo:.2f}, {hi:.2f}]"}  # fmt: skip
+            {
+                "learner": model,
+                "vx ratio to GMR": f"{np.median(a) / np.median(b):.2f}",
+                "95% interval": f"[{lo:.2f}, {hi:.2f}]",
+            }  # fmt: skip
         )
     return table, pd.DataFrame(ratios)
 
@@ -135,14 +140,14 @@ def main() -> None:
         fixed["model"] = "GMR+P (pooled tau)"
         table, ratios = summary(pd.concat([res, fixed]))
         print(f"\n## tau_s = {tau} s\n")
-        print("momentum_information:\n" + diag.to_markdown(index=False) + "\n")
+        print("momentum_information:\n" + to_markdown(diag) + "\n")
         print(f"pooled tau given to GMR+P: {longest:.3f} s\n")
-        print(table.to_markdown(index=False) + "\n\n" + ratios.to_markdown(index=False))
+        print(to_markdown(table) + "\n\n" + to_markdown(ratios))
     for ratio in [v for v in args.ratios.split(",") if v]:
         db = dataset(args.out, f"asymmetric_drag.ratio={ratio}")
         table, ratios = summary(campaign(db, "finsler", "phase-only,TLS,GMR,GMR+F", args))
         print(f"\n## ratio = {ratio}\n")
-        print(table.to_markdown(index=False) + "\n\n" + ratios.to_markdown(index=False))
+        print(to_markdown(table) + "\n\n" + to_markdown(ratios))
 
 
 if __name__ == "__main__":
