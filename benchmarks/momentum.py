@@ -12,8 +12,8 @@ campaign (`run`) on every (train, test) frequency pair of O with `--boots` draws
 `--train-cycles` training cycles. tau_s: GMR, GMR+SUDS, GMR+P, GMR+SUDS+P, then GMR+P
 with the time constant `momentum_information` estimates on the version's samples (all
 frequencies pooled; a campaign's training set holds one frequency, which cannot tell a
-lag from another map) in a second campaign, "GMR+P (pooled tau)". ratio: phase-only,
-TLS, GMR, GMR+F.
+lag from another map) in a second campaign beside GMR, "GMR+P (pooled tau)", whose
+ratio is to that campaign's GMR (the same draws). ratio: phase-only, TLS, GMR, GMR+F.
 
 Printed per value: median held-out RMSE of vx, vy (mm/s), wz (rad/s) per learner,
 same- and different-frequency pairs apart, each with a 95% bootstrap interval of the
@@ -43,8 +43,8 @@ def cli(*args: str) -> None:
 
 
 def dataset(out: Path, effect: str) -> Path:
-    folder = out / effect.replace("=", "_")
-    db = folder.with_suffix(".duckdb")
+    name = effect.replace("=", "-").replace(".", "_")
+    folder, db = out / name, out / f"{name}.duckdb"
     if not db.exists():
         cli("simulate", "--out", str(folder), "--gaits", "O", "--repeats", "2", "--cycles",
             "12:16", "--effect", effect, "--ingest", "--db", str(db))  # fmt: skip
@@ -135,10 +135,15 @@ def main() -> None:
         pooled = diag["tau vx, vy, wz (s)"].iloc[-1]
         longest = max(float(v) for v in pooled.split(","))
         res = campaign(db, "momentum", "GMR,GMR+SUDS,GMR+P,GMR+SUDS+P", args)
-        fixed = campaign(db, "momentum-pooled", "GMR+P", args,
+        # GMR again beside it: the ratio pairs draws of one campaign
+        fixed = campaign(db, "momentum-pooled", "GMR,GMR+P", args,
                          "--model-param", f"GMR+P.tau={longest:.3f}")  # fmt: skip
-        fixed["model"] = "GMR+P (pooled tau)"
-        table, ratios = summary(pd.concat([res, fixed]))
+        fixed["model"] = fixed["model"].replace("GMR+P", "GMR+P (pooled tau)")
+        table, ratios = summary(res)
+        more, more_ratios = summary(fixed)
+        table = pd.concat([table, more[more.learner != "GMR"]])
+        table = table.sort_values(["pairs", "learner"], ascending=[False, True])
+        ratios = pd.concat([ratios, more_ratios])
         print(f"\n## tau_s = {tau} s\n")
         print("momentum_information:\n" + to_markdown(diag) + "\n")
         print(f"pooled tau given to GMR+P: {longest:.3f} s\n")
