@@ -5,6 +5,7 @@ Usage (from the repository root)::
 
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/momentum
         [--taus 0,0.1,0.25,0.5] [--ratios 1,1.5,2.5] [--boots 6] [--train-cycles 4]
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/x --synthetic
 
 For each value: `suds-exp simulate` (gait O at 1/3, 1/2 and 1 Hz, 2 trials of 12-16
 cycles each, the effect set, the rest nominal) with --ingest, `preprocess`, and a
@@ -120,6 +121,44 @@ def diagnostic(db: Path) -> pd.DataFrame:
     return momentum_display(momentum_information(samples, freq))
 
 
+def synthetic_finsler() -> None:
+    """GMR, GMR+F and TLS on the synthetic swimmer with a known asymmetric map
+    (velocity="asymmetric", ratio 1 and 2.5): RMS error of (vx, vy) against the noise-free
+    velocity, trained on 2 trials of 10 cycles of O at 1/2 Hz, tested on 2 trials of 5
+    cycles of O at 1/2 and 1 Hz and D+ at 1/2 Hz; then TLS's prediction against the truth
+    at other frequencies (least-squares slope; 0.5 / f if TLS predicts the training
+    speed's velocity)."""
+    from suds_exp.models import make_model
+    from suds_exp.testing.synthetic_swimmer import make_samples
+
+    def swimmer(ratio, n, gait, f, seed, first):
+        return make_samples(n, gait=gait, frequency_hz=f, n_trials=2, seed=seed,
+                            passive="none", velocity="asymmetric", asymmetry=ratio,
+                            first_trial_id=first)  # fmt: skip
+
+    rows, slopes = [], []
+    for ratio in (1.0, 2.5):
+        train = swimmer(ratio, 10, "O", 0.5, 1, 1)
+        for gait, f in (("O", 0.5), ("O", 1.0), ("D+", 0.5)):
+            test = swimmer(ratio, 5, gait, f, 7, 10)
+            truth = test[["vx_true", "vy_true"]].to_numpy()
+            row = {"ratio": ratio, "test": f"{gait} at {f:g} Hz"}
+            for name in ("GMR", "GMR+F", "TLS"):
+                pred = make_model(name).fit(train).predict(test)[["vx", "vy"]].to_numpy()
+                row[name] = f"{np.sqrt(np.mean((pred - truth) ** 2)):.2f}"
+            row["GMR+F / GMR"] = f"{float(row['GMR+F']) / float(row['GMR']):.2f}"
+            rows.append(row)
+        tls = make_model("TLS").fit(train)
+        for f in (1 / 3, 1.0):
+            test = swimmer(ratio, 5, "O", f, 7, 10)
+            t, q = test["vx_true"].to_numpy(), tls.predict(test)["vx"].to_numpy()
+            slopes.append({"ratio": ratio, "test Hz": f"{f:.3g}",
+                           "slope of TLS's vx on the truth": f"{q @ t / (t @ t):.3f}",
+                           "training / test speed": f"{0.5 / f:.3f}"})  # fmt: skip
+    print("\n## synthetic Finsler swimmer (RMS error of vx, vy, mm/s)\n")
+    print(to_markdown(pd.DataFrame(rows)) + "\n\n" + to_markdown(pd.DataFrame(slopes)))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, required=True)
@@ -127,7 +166,11 @@ def main() -> None:
     ap.add_argument("--ratios", default="1,1.5,2.5")
     ap.add_argument("--boots", type=int, default=6)
     ap.add_argument("--train-cycles", type=int, default=4)
+    ap.add_argument("--synthetic", action="store_true", help="the synthetic Finsler swimmer")
     args = ap.parse_args()
+    if args.synthetic:
+        synthetic_finsler()
+        return
     args.out.mkdir(parents=True, exist_ok=True)
     for tau in [v for v in args.taus.split(",") if v]:
         db = dataset(args.out, f"body_inertia.tau_s={tau}")
