@@ -6,6 +6,7 @@ Usage (from the repository root)::
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/momentum
         [--taus 0,0.1,0.25,0.5] [--ratios 1,1.5,2.5] [--boots 6] [--train-cycles 4]
     OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/x --synthetic
+    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/x --snake ../shared/refdata
 
 For each value: `suds-exp simulate` (gait O at 1/3, 1/2 and 1 Hz, 2 trials of 12-16
 cycles each, the effect set, the rest nominal) with --ingest, `preprocess`, and a
@@ -159,6 +160,29 @@ def synthetic_finsler() -> None:
     print(to_markdown(pd.DataFrame(rows)) + "\n\n" + to_markdown(pd.DataFrame(slopes)))
 
 
+def flying_snake(refdata: Path) -> None:
+    """The real flying-snake glide of docs/results/flying-snake.md, GMR against GMR+P:
+    fitted on the first 70 % of the glide, tested on the rest; and GMR+P's time
+    constants fitted on the training part."""
+    import tempfile
+
+    from suds_exp.body.real_snake import holdout_errors, run_real_snake
+    from suds_exp.models import make_model
+    from suds_exp.preprocess import get_version
+    from suds_exp.store import Store
+
+    capture = refdata / "flying_snake_qualisys" / "413_91.tsv"
+    body = Path(__file__).resolve().parents[1] / "examples" / "flying_snake.toml"
+    with tempfile.TemporaryDirectory() as tmp:
+        db = Path(tmp) / "snake.duckdb"
+        out = run_real_snake([capture], body, db)
+        samples = get_version(Store(db), out["version"]).samples()
+    print("\n## flying snake (RMS error, % of the test RMS)\n")
+    print(to_markdown(holdout_errors(samples, models=("GMR", "GMR+P")), 1))
+    train = samples.iloc[: int(0.7 * len(samples))]
+    print("\nGMR+P tau_ (s):", np.round(make_model("GMR+P").fit(train).tau_, 3))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, required=True)
@@ -167,9 +191,13 @@ def main() -> None:
     ap.add_argument("--boots", type=int, default=6)
     ap.add_argument("--train-cycles", type=int, default=4)
     ap.add_argument("--synthetic", action="store_true", help="the synthetic Finsler swimmer")
+    ap.add_argument("--snake", type=Path, help="refdata folder: the flying snake, GMR vs GMR+P")
     args = ap.parse_args()
     if args.synthetic:
         synthetic_finsler()
+        return
+    if args.snake:
+        flying_snake(args.snake)
         return
     args.out.mkdir(parents=True, exist_ok=True)
     for tau in [v for v in args.taus.split(",") if v]:
