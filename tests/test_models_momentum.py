@@ -99,3 +99,35 @@ def test_bad_time_constants_and_no_body_velocity_are_refused(lagged):
         make_model("GMR+P").fit(train.assign(vx=0.0, vy=0.0, wz=0.0))
     with pytest.raises(ModelError, match="lacks column"):
         make_model("GMR+SUDS+P").fit(train.drop(columns=["vx"]))
+
+
+@pytest.mark.parametrize(
+    ("models", "zero_velocity", "message"),
+    [
+        ({"GMR+P": {"n_momentum": 4}}, False, "expected an integer from 1 to 3"),
+        ({"GMR": {}, "GMR+SUDS+P": {}}, True, r"GMR\+SUDS\+P learns a momentum state"),
+    ],
+)
+def test_campaign_refuses_bad_momentum_requests_with_the_database_unchanged(
+    tmp_path, models, zero_velocity, message
+):
+    from suds_exp.campaign import CampaignOptions, run_campaign
+    from suds_exp.errors import CampaignError
+    from suds_exp.store import Store
+    from tests.conftest import dump_db
+    from tests.test_campaign_grid import synthetic_samples
+
+    samples = synthetic_samples(conditions=(("O", 0.5),), trials_per_condition=2)
+    if zero_velocity:
+        samples = samples.assign(vx=0.0, vy=0.0, wz=0.0)
+    store = Store(tmp_path / "c.duckdb")
+    store.upgrade()
+    before = dump_db(store.path)
+    opts = CampaignOptions(models=models, boots=1, train_cycles=2)
+    with pytest.raises(CampaignError, match=message) as err:
+        run_campaign(store, "c", opts, samples=samples, progress=False)
+    assert "\n" not in str(err.value)
+    after = dump_db(store.path)
+    assert before.keys() == after.keys()
+    for table in before:
+        assert before[table].equals(after[table]), table
