@@ -131,3 +131,12 @@ def test_campaign_refuses_bad_momentum_requests_with_the_database_unchanged(
     assert before.keys() == after.keys()
     for table in before:
         assert before[table].equals(after[table]), table
+
+
+def test_a_gait_run_backwards_is_warmed_up_over_its_first_cycle(lagged):
+    """The state's start is the end of the first cycle of phase travelled either way."""
+    train, test = lagged
+    m = make_model("GMR+P", tau=LAG).fit(train)
+    pred = m.predict(test)
+    backwards = test.assign(phase=-test["phase"])
+    np.testing.assert_allclose(m.predict(backwards), pred, rtol=1e-12, atol=1e-12)

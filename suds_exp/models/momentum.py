@@ -77,7 +77,10 @@ def lag_filter(values: np.ndarray, ts: TimeSeries, tau: float, phase=None) -> np
         alpha = -np.expm1(-dt / tau)
         warm = 0
         if phase is not None:
-            warm = int(np.searchsorted(phase[a:b] - phase[a], 2 * np.pi))
+            # a cycle is 2 pi of phase travelled either way (a gait may run backwards);
+            # a run shorter than a cycle warms up on all of itself
+            done = np.flatnonzero(np.abs(phase[a:b] - phase[a]) >= 2 * np.pi)
+            warm = int(done[0]) if done.size else b - a
         x = values[a:b] if warm == 0 else np.concatenate([values[a : a + warm], values[a:b]])
         zi = (1 - alpha) * x[:1]
         y, _ = lfilter([alpha], [1.0, alpha - 1.0], x, axis=0, zi=zi)
