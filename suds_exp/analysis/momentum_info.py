@@ -5,11 +5,12 @@ A lag of the body velocity shows, and can be told from a different quasi-static 
 only across speeds: at one gait frequency a lagged periodic velocity is just another
 periodic velocity. So the diagnostic holds each gait frequency out in turn, fits GMR and
 GMR+P on the trials at the other frequencies (up to `cycles` cycles of each, from its
-second cycle, past the start from rest) and tests both on every trial at the held-out
-frequency. The ratio of the median errors (GMR+P / GMR, RMSE of vx) has a bootstrap
-interval over the held-out trials; "helps" when the whole interval lies below 1.
-GMR+P's time constants fitted on all frequencies together are reported too: the value
-to give `GMR+P` (``tau``) in a campaign, whose training sets hold one condition each.
+second cycle, past the start from rest; a few trials per frequency, decimated as a
+campaign decimates) and tests both on the trials at the held-out frequency. The ratio of
+the median errors (GMR+P / GMR, RMSE of vx) has a bootstrap interval over the held-out
+trials; "helps" when the whole interval lies below 1. GMR+P's time constants fitted on
+all frequencies together are reported too: the value to give `GMR+P` (``tau``) in a
+campaign, whose training sets hold one condition each.
 """
 
 from __future__ import annotations
@@ -41,11 +42,22 @@ MOMENTUM_EXPLANATION = (
 )
 
 
-def _windows(samples: pd.DataFrame, cycles: int) -> pd.DataFrame:
-    """Up to ``cycles`` cycles of each trial, from its second cycle on."""
+def _windows(
+    samples: pd.DataFrame, cycles: int, samples_per_cycle: int, max_trials: int
+) -> pd.DataFrame:
+    """Up to ``cycles`` cycles of each trial, from its second cycle on, every k-th sample
+    so that a cycle keeps about ``samples_per_cycle``; the first ``max_trials`` trials of
+    each frequency (column ``_f``)."""
+    trials = samples.drop_duplicates("trial_id").sort_values("trial_id")
+    chosen = trials.groupby("_f").head(max_trials)["trial_id"]
+    samples = samples[samples["trial_id"].isin(chosen)]
     first = samples.groupby("trial_id")["cycle"].transform("min")
     keep = (samples["cycle"] >= first + 1) & (samples["cycle"] < first + 1 + cycles)
-    return samples[keep]
+    samples = samples[keep]
+    per_cycle = samples.groupby("trial_id")["cycle"].transform("size") / cycles
+    step = np.maximum(1, np.round(per_cycle / samples_per_cycle)).astype(int)
+    position = samples.groupby("trial_id").cumcount()
+    return samples[(position % step) == 0]
 
 
 def _trial_rmse(pred: pd.DataFrame, test: pd.DataFrame) -> np.ndarray:
@@ -59,12 +71,17 @@ def momentum_information(
     cycles: int = 4,
     n_boot: int = 400,
     seed: int = 0,
+    samples_per_cycle: int = 50,
+    max_trials: int = 6,
 ) -> pd.DataFrame:
     """The momentum-information table (`MOMENTUM_COLUMNS`) of a samples frame.
 
     ``frequencies``: each trial's gait frequency in Hz, indexed by trial_id. Empty when
     the samples hold fewer than two frequencies (nothing to hold out across speeds).
-    Errors in mm/s, time constants in s.
+    ``cycles`` cycles of at most ``max_trials`` trials per frequency are used, decimated
+    to about ``samples_per_cycle`` samples a cycle (as a campaign decimates), so the cost
+    stays that of a few small fits whatever the recording's size. Errors in mm/s, time
+    constants in s.
     """
     from suds_exp.models import make_model
 
@@ -72,7 +89,7 @@ def momentum_information(
     levels = sorted(freq.dropna().unique())
     if len(levels) < 2:
         return pd.DataFrame(columns=MOMENTUM_COLUMNS)
-    data = _windows(samples.assign(_f=freq.to_numpy()), cycles)
+    data = _windows(samples.assign(_f=freq.to_numpy()), cycles, samples_per_cycle, max_trials)
     rng = np.random.default_rng(seed)
     rows, all_gmr, all_p = [], [], []
     for f in levels:
