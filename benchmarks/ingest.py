@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from suds_exp.ingest import ROLES, ingest_paths  # noqa: E402
 from suds_exp.store import Store  # noqa: E402
-from tests.conftest import qtm_text, random_track  # noqa: E402
+from tests.helpers import qtm_text, random_track  # noqa: E402
 
 
 def main() -> None:

@@ -47,6 +47,8 @@ SLOW_FILES = (
     "test_body_segments.py",
     "test_models_sklearn.py",
     "test_stream.py",
+    "test_models_momentum.py",
+    "test_momentum_information.py",
 )
 
 

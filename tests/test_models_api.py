@@ -8,7 +8,13 @@ import pytest
 from sklearn.base import clone
 
 from suds_exp.errors import ConfigError, SudsError
-from suds_exp.models import MODEL_NAMES, ModelError, make_model
+from suds_exp.models import (
+    FINSLER_MODELS,
+    MODEL_NAMES,
+    MOMENTUM_MODELS,
+    ModelError,
+    make_model,
+)
 from suds_exp.testing.synthetic_swimmer import make_samples
 
 VARIANTS = [(name, {}) for name in MODEL_NAMES] + [
@@ -17,6 +23,10 @@ VARIANTS = [(name, {}) for name in MODEL_NAMES] + [
     ("GMR", {"branching": "filter"}),
     ("GMR", {"branching": "history"}),
     ("GMR", {"augment": "dilation"}),
+    *((name, {}) for name in MOMENTUM_MODELS),
+    ("GMR+SUDS+P", {"mode": "rollout"}),
+    *((name, {}) for name in FINSLER_MODELS),
+    ("GMR+F", {"branching": "history"}),
 ]
 IDS = [n + "".join(f"-{v}" for v in p.values()) for n, p in VARIANTS]
 
@@ -93,6 +103,7 @@ def test_passive_dimension_is_inferred(data):
         ("GMR", {"augment_range": (2.0, 1.0)}, "augment_range"),
         ("GMR", {"reg_covar": 0.0}, "reg_covar"),
         ("GMR+SUDS", {"branching": "sometimes"}, "branching"),
+        ("GMR+F", {"augment": "dilation"}, "augment"),
     ],
 )
 def test_bad_hyper_parameters_are_refused_in_fit(data, name, params, match):
@@ -125,7 +136,7 @@ def test_a_gap_inside_a_trial_restarts_the_series(data):
         np.testing.assert_allclose(m.predict(cut), m.predict(as_two), rtol=1e-9, atol=1e-9)
 
 
-@pytest.mark.parametrize("name", MODEL_NAMES)
+@pytest.mark.parametrize("name", [*MODEL_NAMES, *MOMENTUM_MODELS, *FINSLER_MODELS])
 def test_every_hyper_parameter_lands_in_its_own_attribute(name):
     """Subclasses forward their parameters positionally; a swapped pair would go unseen
     by the round-trip test, so set each to a distinct marker and read it back."""

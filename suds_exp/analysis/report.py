@@ -26,6 +26,7 @@ from suds_exp.analysis.formatting import (
     write_table,
 )
 from suds_exp.analysis.glm import LEVEL_NAMES, REFERENCE, glm_table
+from suds_exp.analysis.momentum_info import momentum_section
 from suds_exp.analysis.paper import agreement_summary, compare_glm, compare_iqr, paper_table
 from suds_exp.analysis.passive import (
     PASSIVE_EXPLANATION,
@@ -217,7 +218,8 @@ def write_report(
         else '<h2 id="findings">The paper\'s findings</h2>\n'
         + not_computed_html(tables.missing["findings"], files["findings"])
     )
-    page = page.replace(_FINDINGS_SLOT, findings + _passive_html(passive, passive_files), 1)
+    findings += _passive_html(passive, passive_files) + momentum_section(store, campaign, out)
+    page = page.replace(_FINDINGS_SLOT, findings, 1)
     page = page.replace(_SKIPPED_SLOT, skipped_html(store, campaign), 1)
     index = out / "index.html"
     index.write_text(page, encoding="utf-8")

@@ -23,7 +23,8 @@ from suds_exp.campaign.conditions import (
 )
 from suds_exp.campaign.sampling import infeasible_cells
 from suds_exp.errors import CampaignError, ConfigError
-from suds_exp.models.registry import LEARNERS
+from suds_exp.models.registry import LEARNERS, MOMENTUM_SUFFIX
+from suds_exp.robot import VB_COLUMNS
 
 MODES = ("measured", "rollout")
 DEFINITION_VERSION = 1
@@ -181,6 +182,7 @@ def make_plan(
     test = _conditions(options.test_conditions, available, "test_conditions")
     models = resolve_models(options.models, options.mode)
     bank = bank_for(sorted(set(train) | set(test)))
+    _check_velocity(models, bank)
     sweep = sorted({int(n) for n in options.sweep})
     stored_options = {
         "prep": options.prep,
@@ -233,6 +235,20 @@ def make_plan(
         skipped=tuple(skipped),
     )
     return plan, bank
+
+
+def _check_velocity(models: dict, bank) -> None:
+    """A momentum learner learns from measured body velocity: refuse it, before anything
+    is written, on samples whose vx, vy, wz are zero throughout (a version of a tethered
+    body, or one whose velocity was never measured)."""
+    momentum = [m for m in models if m.endswith(MOMENTUM_SUFFIX)]
+    cols = [bank.columns.index(c) for c in VB_COLUMNS if c in bank.columns]
+    if momentum and (len(cols) < len(VB_COLUMNS) or not np.any(bank.values[:, cols])):
+        raise CampaignError(
+            f"models: {momentum[0]} learns a momentum state from the body velocity, and "
+            "the version's samples have none (vx, vy, wz zero throughout)",
+            param="models",
+        )
 
 
 def _conditions(value, available, option) -> list[Condition]:

@@ -6,6 +6,12 @@ import pandas as pd
 
 from suds_exp import console
 from suds_exp.analysis.findings import findings, findings_display, findings_headline, findings_json
+from suds_exp.analysis.momentum_info import (
+    MOMENTUM_EXPLANATION,
+    campaign_momentum_information,
+    momentum_display,
+    momentum_reason,
+)
 from suds_exp.analysis.passive import (
     PASSIVE_EXPLANATION,
     campaign_passive_information,
@@ -17,16 +23,19 @@ from suds_exp.analysis.passive import (
 def show_findings(store, name: str, n_boot: int = 400, seed: int = 0, as_json=False) -> None:
     """Measure the findings of campaign ``name`` and what the passive shape adds, and print
     them: tables and headline, or one JSON document (`findings_json` with a
-    ``passive_information`` list)."""
+    ``passive_information`` and a ``momentum_information`` list)."""
     table = findings(store, name, n_boot=n_boot, seed=seed)
     passive = campaign_passive_information(store, name, n_boot=n_boot, seed=seed)
+    momentum = campaign_momentum_information(store, name, n_boot=n_boot, seed=seed)
     if as_json:
         doc = findings_json(table, name)
         doc["passive_information"] = passive.to_dict(orient="records")
+        doc["momentum_information"] = momentum.to_dict(orient="records")
         console.print_json(doc)
     else:
         print_findings(table, name)
         print_passive_information(passive)
+        print_momentum_information(momentum)
 
 
 def print_findings(table: pd.DataFrame, campaign: str) -> None:
@@ -47,3 +56,13 @@ def print_passive_information(table: pd.DataFrame) -> None:
         return
     console.print_frame(passive_display(table), title="what the passive shape adds")
     console.out.print(PASSIVE_EXPLANATION)
+
+
+def print_momentum_information(table: pd.DataFrame) -> None:
+    """Print the momentum-information table and its explanation on the terminal."""
+    if table.empty:
+        reason = momentum_reason(table)
+        console.out.print(f"what the velocity history adds: not measurable ({reason})")
+        return
+    console.print_frame(momentum_display(table), title="what the velocity history adds")
+    console.out.print(MOMENTUM_EXPLANATION)

@@ -14,6 +14,13 @@ Online learners (`ONLINE_MODELS`, also built by `make_model`) add `partial_fit(s
 `OnlineGMR` and `OnlineGMR+SUDS` (`online.OnlineGMR`, `online.OnlineGMRSuds`), and
 `GradualGMR+SUDS` (`gradual.GradualGMRSuds`: GMR that adds passive coordinates online).
 
+Momentum learners (`MOMENTUM_MODELS`, the paper's Future Work): `GMR+P` and
+`GMR+SUDS+P` (`momentum.GMRMomentum`, `momentum.GMRSudsMomentum`), body velocity relaxing
+to a learned quasi-static GMR map with learned time constants.
+
+`GMR+F` (`finsler.GMRFinsler`, `FINSLER_MODELS`): GMR on the positive and negative parts
+of each shape velocity, a map homogeneous but not linear in it (Finsler contact).
+
 Beyond the paper (`sklearn_adapter.py`; names and recipes in `sklearn_recipes.py`):
 `MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each also `+SUDS`) and `sklearn:ClassName` /
 `sklearn:pkg.mod.Class` (any regressor, `+SUDS` for GMR+SUDS's inputs);
@@ -29,11 +36,19 @@ from functools import cache
 
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import Learner, ModelError
+from suds_exp.models.finsler import GMRFinsler
 from suds_exp.models.gmr import GMR, GMRSuds
 from suds_exp.models.gradual import GradualGMRSuds
+from suds_exp.models.momentum import GMRMomentum, GMRSudsMomentum
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
-from suds_exp.models.registry import BASELINE_LEARNERS, LEARNERS, ONLINE_LEARNERS
+from suds_exp.models.registry import (
+    BASELINE_LEARNERS,
+    FINSLER_LEARNERS,
+    LEARNERS,
+    MOMENTUM_LEARNERS,
+    ONLINE_LEARNERS,
+)
 from suds_exp.models.sklearn_adapter import SklearnLearner
 from suds_exp.models.sklearn_recipes import make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
@@ -47,6 +62,12 @@ MODEL_NAMES = LEARNERS
 ONLINE_MODELS: dict[str, type[Learner]] = dict(
     zip(ONLINE_LEARNERS, (OnlineGMR, OnlineGMRSuds, GradualGMRSuds), strict=True)
 )
+#: Learners with a momentum state (`momentum.py`).
+MOMENTUM_MODELS: dict[str, type[Learner]] = dict(
+    zip(MOMENTUM_LEARNERS, (GMRMomentum, GMRSudsMomentum), strict=True)
+)
+#: Learners whose map is homogeneous but not linear in the shape velocity (`finsler.py`).
+FINSLER_MODELS: dict[str, type[Learner]] = dict(zip(FINSLER_LEARNERS, (GMRFinsler,), strict=True))
 #: The survey's named baselines (scikit-learn regressors with documented defaults).
 BASELINE_NAMES = BASELINE_LEARNERS
 
@@ -58,15 +79,16 @@ def make_model(name: str, **params) -> Learner:
     `sklearn_recipes`). Unknown names or parameters raise ConfigError; parameter values are
     checked by `fit` (by scikit-learn's own checks here for the adapter).
     """
-    adapter = make_adapter(name, params) if name not in MODELS else None
+    builders = {**MODELS, **ONLINE_MODELS, **MOMENTUM_MODELS, **FINSLER_MODELS}
+    adapter = make_adapter(name, params) if name not in builders else None
     if adapter is not None:
         return adapter
     try:
-        cls = MODELS[name] if name in MODELS else ONLINE_MODELS[name]
+        cls = builders[name]
     except KeyError:
         raise ConfigError(
             f"unknown model {name!r}; expected one of "
-            f"{', '.join(MODEL_NAMES + tuple(ONLINE_MODELS) + BASELINE_NAMES)}"
+            f"{', '.join((*builders, *BASELINE_NAMES))}"
             " or sklearn:ClassName"
         ) from None
     valid = _param_names(cls)
@@ -105,6 +127,11 @@ __all__ = [
     "OnlineGMRSuds",
     "GradualGMRSuds",
     "ModelError",
+    "MOMENTUM_MODELS",
+    "GMRMomentum",
+    "GMRSudsMomentum",
+    "FINSLER_MODELS",
+    "GMRFinsler",
     "make_model",
     "GMR",
     "GMRSuds",

@@ -348,7 +348,7 @@ class GMR(Learner):
         self.bic_ = best_bic
         d = Xin.shape[1]
         self._cond = Conditional.of(
-            self.priors_, self.means_, self.covariances_, np.arange(d), np.arange(d, len(rate))
+            self.priors_, self.means_, self.covariances_, np.arange(d), np.arange(d, Z.shape[1])
         )
         self.transition_ = None
         if self.branching == "filter":

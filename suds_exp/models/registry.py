@@ -15,6 +15,10 @@ from dataclasses import dataclass
 
 #: The suffix of a learner that also sees the passive shape (SUDS): ``GMR+SUDS``.
 SUDS_SUFFIX = "+SUDS"
+#: The suffix of a learner with a momentum state: ``GMR+P``, ``GMR+SUDS+P``.
+MOMENTUM_SUFFIX = "+P"
+#: The suffix of a learner whose map is not linear in the shape velocity: ``GMR+F``.
+FINSLER_SUFFIX = "+F"
 #: Tags: the paper's five; ``models="survey"`` of a campaign; ``partial_fit``; the
 #: scikit-learn baselines of `baselines.BASELINES`.
 TAGS = ("paper", "survey", "online", "baseline")
@@ -58,6 +62,11 @@ REGISTRY: tuple[LearnerInfo, ...] = (
     _learner("GMR", False, "online", name="OnlineGMR"),
     _learner("GMR", True, "online", name="OnlineGMR+SUDS"),
     _learner("GMR", True, "online", name="GradualGMR+SUDS"),
+    # the paper's Future Work: a low-dimensional momentum state (models/momentum.py)
+    _learner("GMR", False, name="GMR" + MOMENTUM_SUFFIX),
+    _learner("GMR", True, name="GMR" + SUDS_SUFFIX + MOMENTUM_SUFFIX),
+    # and a map homogeneous but not linear in the shape velocity (models/finsler.py)
+    _learner("GMR", False, name="GMR" + FINSLER_SUFFIX),
 )
 BY_NAME = {info.name: info for info in REGISTRY}
 
@@ -77,5 +86,9 @@ SURVEY_LEARNERS = tagged("survey")
 ONLINE_LEARNERS = tagged("online")
 #: The named scikit-learn baselines, each with and without SUDS.
 BASELINE_LEARNERS = tagged("baseline")
+#: Learners with a momentum state (`models.momentum`): untagged, in `REGISTRY` order.
+MOMENTUM_LEARNERS = tuple(i.name for i in REGISTRY if i.name.endswith(MOMENTUM_SUFFIX))
+#: Learners whose map is homogeneous but not linear in the shape velocity.
+FINSLER_LEARNERS = tuple(i.name for i in REGISTRY if i.name.endswith(FINSLER_SUFFIX))
 #: The paper's five by role, for code that compares them (findings, synthetic results).
 PHASE_ONLY, TLS, TLS_SUDS, GMR, GMR_SUDS = LEARNERS

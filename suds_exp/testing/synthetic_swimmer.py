@@ -16,13 +16,21 @@ Body velocity (body frame; vx, vy mm/s, wz rad/s):
 - "linear":  v_b = A(r) dr_a/dt (principally kinematic, linear in dr_a/dt)
 - "finsler": v_b = A(r) dr_a/dt + b(r_a) |dr_a/dt| (homogeneous of degree 1, not linear:
   asymmetric, direction-dependent friction)
+- "asymmetric": v_b = A(r) ([dr_a/dt]+ + `asymmetry` [dr_a/dt]-), [x]+ = max(x, 0),
+  [x]- = min(x, 0): a joint closing moves the body `asymmetry` times as far as opening
+  (a Finsler map with a known asymmetry ratio; linear at 1)
 with A(r) = A_a(r_a) + A_p(r_p) given by `connection`.
+
+Momentum (`body_tau` s > 0): the body velocity relaxes towards the map above,
+dv/dt = (v_map - v) / body_tau, integrated exactly at the substep (a body whose momentum
+matters; 0 = the principally kinematic swimmer). Each trial starts at rest on the map.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from scipy.signal import lfilter
 
 from suds_exp.errors import ConfigError
 from suds_exp.robot import gait_shape, gait_shape_rate
@@ -69,7 +77,22 @@ def _wobble(t: np.ndarray, f: float, tube: float, rng) -> tuple[np.ndarray, np.n
     return e, de
 
 
-def _trial(n_cycles, gait, f, spc, tube, passive, velocity, tau, ell, substeps, rp_start, rng):
+def _trial(
+    n_cycles,
+    gait,
+    f,
+    spc,
+    tube,
+    passive,
+    velocity,
+    tau,
+    ell,
+    substeps,
+    rp_start,
+    rng,
+    body_tau,
+    asymmetry=1.0,
+):
     n = int(round(n_cycles * spc))
     fs = f * spc
     nf = n * substeps
@@ -96,12 +119,18 @@ def _trial(n_cycles, gait, f, spc, tube, passive, velocity, tau, ell, substeps, 
             x = (x + h * forcing[i]) / denom[i]
             rp[i] = x
         drp = forcing - lam[:, None] * rp
-    sl = slice(None, None, substeps)
-    ra, dra, rp, drp, theta, t = ra[sl], dra[sl], rp[sl], drp[sl], theta[sl], tf[sl]
     A = connection(ra, rp if passive != "none" else None)
-    v = np.einsum("nij,nj->ni", A, dra)
+    if velocity == "asymmetric":
+        v = np.einsum("nij,nj->ni", A, np.maximum(dra, 0) + asymmetry * np.minimum(dra, 0))
+    else:
+        v = np.einsum("nij,nj->ni", A, dra)
     if velocity == "finsler":
         v += _finsler_bias(ra) * np.linalg.norm(dra, axis=1)[:, None]
+    if body_tau > 0:
+        a = -np.expm1(-1.0 / (fs * substeps * body_tau))
+        v = lfilter([a], [1.0, a - 1.0], v, axis=0, zi=(1 - a) * v[:1])[0]
+    sl = slice(None, None, substeps)
+    ra, dra, rp, drp, theta, t, v = ra[sl], dra[sl], rp[sl], drp[sl], theta[sl], tf[sl], v[sl]
     return t, theta - theta0 + (theta0 % (2 * np.pi)), ra, dra, rp, drp, v
 
 
@@ -124,6 +153,8 @@ def make_samples(
     rp_start: tuple = (0.0, 0.0),
     first_trial_id: int = 1,
     seed: int = 0,
+    body_tau: float = 0.0,
+    asymmetry: float = 1.0,
 ) -> pd.DataFrame:
     """A samples frame (columns of the `samples` table) from the synthetic swimmer.
 
@@ -135,8 +166,10 @@ def make_samples(
     """
     if passive not in ("lag", "travel", "none"):
         raise ConfigError(f"synthetic: passive={passive!r}; expected lag, travel or none")
-    if velocity not in ("linear", "finsler"):
-        raise ConfigError(f"synthetic: velocity={velocity!r}; expected linear or finsler")
+    if velocity not in ("linear", "finsler", "asymmetric"):
+        raise ConfigError(
+            f"synthetic: velocity={velocity!r}; expected linear, finsler or asymmetric"
+        )
     rng = np.random.default_rng(seed)
     frames = []
     for j in range(n_trials):
@@ -153,6 +186,8 @@ def make_samples(
             substeps,
             np.asarray(rp_start, dtype=float),
             rng,
+            body_tau,
+            asymmetry,
         )
         n = len(t)
         d = {
