@@ -56,7 +56,8 @@ def preprocess_text(result) -> str:
         f"in {result.seconds:.1f} s; "
         f"{explained_label(result.params)} explain {ev}"
         + (
-            f"; {result.interpolated_pose_frames} segment poses interpolated (too few markers seen)"
+            f"; {result.interpolated_pose_frames} segment poses interpolated (too few "
+            "markers seen)"
             if result.interpolated_pose_frames
             else ""
         )
