@@ -8,15 +8,17 @@ imports it, and it is the one module allowed to import cli (pyproject.toml,
 """
 
 import importlib
+from pathlib import Path
 
 
 def _app():
-    # the installed name first: a user's own `cli.py` in the working folder is not ours.
-    # By string, since suds_exp.app exists only in a wheel, never in the source tree
-    try:
-        return importlib.import_module("suds_exp.app.cli").app
-    except ModuleNotFoundError:
+    # a checkout (cli.py and pyproject.toml beside the package) runs its own cli.py; an
+    # installed wheel its suds_exp.app.cli. By name, since suds_exp.app exists only in a
+    # wheel, never in the source tree
+    top = Path(__file__).resolve().parents[1]
+    if (top / "cli.py").is_file() and (top / "pyproject.toml").is_file():
         return importlib.import_module("cli").app
+    return importlib.import_module("suds_exp.app.cli").app
 
 
 app = _app()

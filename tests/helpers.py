@@ -37,6 +37,7 @@ SLOW_FILES = (
     "test_experiment_stored.py",
     "test_gait_bodies.py",
     "test_docs.py",
+    "test_cli_help.py",
     "test_ingest_cli.py",
     "test_experiment_design.py",
     "test_preprocess_versions.py",

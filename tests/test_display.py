@@ -48,7 +48,7 @@ def test_store_version_and_a_run_show_their_size_and_state(tmp_path):
     ):  # fmt: skip
         assert runner.invoke(app, args, env=env).exit_code == 0
     store = Store(db)
-    assert "trials=2, versions=1" in repr(store)
+    assert "trials=2, campaigns=0" in repr(store)
     assert "MB" in repr(store) and "<table" in store._repr_html_()
 
     version = get_version(store)

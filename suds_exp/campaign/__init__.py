@@ -7,8 +7,9 @@ fills `results`; `campaign_status(store, name)` reports its progress (the small 
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from suds_exp.lazy import exports
 
 if TYPE_CHECKING:  # what the names are, for readers and static tools; loaded on first use
     from suds_exp.campaign.bank import SampleBank
@@ -39,19 +40,6 @@ _HOMES = {
 }
 
 
-def __getattr__(name: str):
-    home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module 'suds_exp.campaign' has no attribute {name!r}")
-    value = getattr(importlib.import_module(home), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
-
-
 __all__ = [
     "KEY_COLUMNS",
     "PAPER_SWEEP",
@@ -67,3 +55,5 @@ __all__ = [
     "parse_int_list",
     "run_campaign",
 ]
+
+__getattr__, __dir__ = exports(__name__, _HOMES, __all__)

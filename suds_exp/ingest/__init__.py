@@ -4,8 +4,9 @@ experiment description kept with the data (`stored_design`, `add_trial_levels`).
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from suds_exp.lazy import exports
 
 if TYPE_CHECKING:  # what the names are, for readers and static tools; loaded on first use
     from suds_exp.ingest.capture import Capture
@@ -47,19 +48,6 @@ _HOMES = {
 }
 
 
-def __getattr__(name: str):
-    home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module 'suds_exp.ingest' has no attribute {name!r}")
-    value = getattr(importlib.import_module(home), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
-
-
 __all__ = [
     "Capture",
     "Condition",
@@ -81,3 +69,5 @@ __all__ = [
     "trial_level_axis",
     "trial_layout",
 ]
+
+__getattr__, __dir__ = exports(__name__, _HOMES, __all__)

@@ -6,8 +6,9 @@ through DuckDB alone, for the small commands that start in a fraction of a secon
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from suds_exp.lazy import exports
 
 if TYPE_CHECKING:  # what the names are, for readers and static tools; loaded on first use
     from suds_exp.store.engine import default_db_path
@@ -24,17 +25,6 @@ _HOMES = {
 }
 
 
-def __getattr__(name: str):
-    home = _HOMES.get(name)
-    if home is None:
-        raise AttributeError(f"module 'suds_exp.store' has no attribute {name!r}")
-    value = getattr(importlib.import_module(home), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
-
-
 __all__ = ["Store", "default_db_path", "frame_to_json", "run_readonly"]
+
+__getattr__, __dir__ = exports(__name__, _HOMES, __all__)

@@ -126,13 +126,13 @@ def trial_rows(path: Path) -> Rows:
     return read_rows(path, TRIALS_SQL)
 
 
-#: what a database holds, as a `Store` shows it: table -> what its rows are called
-CONTENTS = {"trials": "trials", "prep_versions": "versions", "campaigns": "campaigns",
-            "results": "results"}  # fmt: skip
+#: what a database holds, as a `Store` shows it: table -> what its rows are called (the
+#: preprocessing versions are preprocess's to read: a `Version` shows itself)
+CONTENTS = {"trials": "trials", "campaigns": "campaigns", "results": "results"}
 
 
 def contents(path: Path) -> dict[str, int] | str:
-    """How many trials, versions, campaigns and results the file ``path`` holds, read in
+    """How many trials, campaigns and results the file ``path`` holds, read in
     one try (no waiting: a notebook's display must not hang); else why not, in words."""
     path = Path(path)
     if not path.exists():
