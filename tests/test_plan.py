@@ -87,6 +87,30 @@ def test_next_map_recommends_declared_levels_with_reasons_and_a_stop_signal(db, 
     assert len(stop["cycles"]) == 2 and stop["message"].split(":")[0] in ("stop", "continue")
 
 
+def test_the_map_criterion_discounts_what_is_recorded_and_spreads_a_batch(small):
+    from suds_exp.plan import MapEnsemble
+    from suds_exp.plan.recommend import recommend_map
+    from suds_exp.preprocess import get_version
+
+    samples = get_version(Store(small), "v1").samples()  # ten cycles of O at 1/2 Hz
+    ensemble = MapEnsemble.fit(samples, n_boot=3, seed=0)
+    target = Target()
+
+    def score(recs, gait, freq):
+        return next(
+            r.score for r in recs if (r.trial.gait.name, r.trial.frequency_hz) == (gait, freq)
+        )
+
+    blind = recommend_map(ensemble, target, 10, n=15)
+    seen = recommend_map(ensemble, target, 10, n=15, samples=samples)
+    # the ten recorded cycles of O take most of what another O trial would remove
+    assert score(seen, "O", 0.5) < 0.5 * score(blind, "O", 0.5)
+    # a batch spreads over the gaits at the target's frequency before repeating any
+    first = [(r.trial.gait.name, r.trial.frequency_hz) for r in seen[:4]]
+    assert {g for g, _ in first} == {"S+", "S-", "D-", "D+"}
+    assert all(f == 0.5 for _, f in first)
+
+
 def test_next_gait_writes_a_new_gait_file_within_the_bound(db, tmp_path):
     target = Target.of(bound=1.2)
     advice = plan_next(

@@ -13,10 +13,17 @@ Two goals:
   removes the share m / (n0 + n + m) of it (n0 = `PRIOR_CYCLES`, the prior's worth). The
   kernel's length-scale is the candidates' spacing (`candidate_spacing`: the widest gap
   from a candidate's path to its nearest neighbour's): the learner interpolates between
-  neighbouring paths, so a cycle informs the map as far as the next candidate's path. A cycle at another frequency than the target's counts half (the map
-  is rate-independent only as far as the robot is). What is already recorded is so
-  discounted, a path sample no data visit yet gives up all its variance, and a batch of
-  ``n`` trials is chosen greedily, each scored after the ones before it.
+  neighbouring paths, so a cycle informs the map as far as the next candidate's path.
+  A cycle at another frequency than the target's counts half (the map is
+  rate-independent only as far as the robot is). What is already recorded is so
+  discounted, a path sample far from all data keeps nearly all its variance for the
+  first trial that comes near, and a batch of ``n`` trials is chosen greedily, each
+  scored as if the ones before it were recorded.
+
+  Why not the bootstrap alone: the cycle bootstrap sees the noise of what is recorded,
+  not the bias of a map that has seen only a few paths (after 35 cycles of three gaits
+  its variance over the default target was about 5 mm^2 against a squared error near
+  40 mm^2), so on its own it keeps choosing the paths nearest the target.
 - ``"gait"``: the best forward displacement per cycle within the bound. The next trial is
   a new Fourier gait (written to a file) that maximises the upper confidence bound
   (point prediction + `KAPPA` x bootstrap spread) inside the joint bound and inside a
