@@ -136,8 +136,9 @@ def arm_random(seed: int, budget: int, cycles: int, bound: float, truth, work) -
 
 
 def arm_plan(
-    seed: int, budget: int, goal: str, bound: float, cycles: int, work, truth=None
-) -> list[dict]:
+    seed: int, budget: int, goal: str, bound: float, cycles: int, work, truth=None,
+    spread_boots: int = 8,
+) -> list[dict]:  # fmt: skip
     """The loop's curve rows; for the map goal (``truth`` given) each row also has the
     bootstrap spread of the map error (`error_spread`) and the loop's stop signal."""
     opts = LoopOptions(goal=goal, bound=bound, budget_cycles=budget, seed=seed, cycles=cycles)
@@ -158,7 +159,8 @@ def arm_plan(
         trial_ids = [it.trial_id for it in loop.iterations]
         for k, row in enumerate(rows):
             part = samples[samples["trial_id"].isin(trial_ids[: k + 1])]
-            row["error_spread_mm"] = error_spread(part, truth, derive_seed("flat", seed, k))
+            key = derive_seed("flat", seed, k)
+            row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
     return rows
 
 
@@ -281,7 +283,7 @@ def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[l
         elif arm == "plan":
             rows = arm_plan(
                 seed, budget, goal, args.bound, args.cycles, work,
-                truth if goal == "map" else None,
+                truth if goal == "map" else None, args.spread_boots,
             )  # fmt: skip
         elif arm == "fullgrid":
             rows = [arm_fullgrid(seed, truth, work)]
@@ -311,6 +313,10 @@ def main() -> None:
     ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
     ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms ('' for none)")
     ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
+    ap.add_argument(
+        "--spread-boots", type=int, default=8,
+        help="bootstrap refits of the map error's spread (the flattening check)",
+    )  # fmt: skip
     ap.add_argument(
         "--map-arms", default="grid,random,plan",
         help="map-goal arms (grid, random, plan, fullgrid: the full grid's error alone)",

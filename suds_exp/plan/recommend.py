@@ -185,12 +185,13 @@ def recommend_map(
     scale = candidate_spacing([g for g, _ in candidates], n_path)
     recorded = recorded_cycles_near(samples, target, n_path, scale)
     paths = [_path_features(g, n_path) for g, _ in pairs]
-    brings = []
+    brings, reach = [], []
     for gait, freq in candidates:
         tree = cKDTree(_path_features(gait, n_path))
         visited = np.array([nearness(tree.query(path)[0], scale) for path in paths])
         weights = np.array([_frequency_weight(freq, f) for _, f in pairs])
         brings.append(cycles * weights[:, None] * visited)
+        reach.append(int(np.sum(visited.max(axis=1) > 0.5)))
     recs: list[Recommendation] = []
     taken: set[int] = set()
     for _ in range(min(n, len(candidates))):
@@ -204,9 +205,9 @@ def recommend_map(
         )
         i = int(np.argmax(removed))
         m = brings[i]
-        near = recorded[m > 0.5 * cycles]
+        near = recorded[m > 0.5 * m.max()]
         gait, freq = candidates[i]
-        covered = int(np.sum((m > 0.5 * cycles).any(axis=1)))
+        covered = reach[i]
         reason = (
             f"expected to remove {removed[i]:.2f} mm^2 of the target's prediction variance "
             f"of {per_sample.sum():.2f} ({covered} of {len(pairs)} targets visited, where "
