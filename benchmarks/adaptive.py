@@ -26,7 +26,12 @@ predicted from simulated net displacement per cycle, mm) for grid, random and th
 plan loop with --goal map.
 
 Run: .venv/bin/python benchmarks/adaptive.py --seeds 0,1,2 --budget 50 --bo-budget 150
-         [--map-budget 150] [--designer] [--out reports/adaptive]
+         [--map-budget 390 --map-arms plan,fullgrid] [--designer] [--out reports/adaptive]
+
+For the map goal's plan loop the benchmark also measures where the map-error curve
+flattens (the next doubling of cycles lowers the error by less than its bootstrap
+spread, GMR refitted on cycle-block resamples) and whether the loop's stopping signal
+first fired within 20 % of that count (`flattening`, in summary.json).
 Writes curves.csv, summary.json and the figures gait.png (and map.png) to --out.
 (`pip install -e '.[bench]'` installs bayesian-optimization.)
 """
@@ -53,6 +58,7 @@ from suds_exp.gait.trials import gait_trial_specs  # noqa: E402
 from suds_exp.gait.truth import simulate_forward  # noqa: E402
 from suds_exp.ingest import ingest_paths  # noqa: E402
 from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop  # noqa: E402
+from suds_exp.plan.ensemble import block_draws  # noqa: E402
 from suds_exp.plan.recommend import Trial  # noqa: E402
 from suds_exp.plan.record import record_trial  # noqa: E402
 from suds_exp.preprocess import get_version, preprocess  # noqa: E402
@@ -129,17 +135,63 @@ def arm_random(seed: int, budget: int, cycles: int, bound: float, truth, work) -
     return arm.rows
 
 
-def arm_plan(seed: int, budget: int, goal: str, bound: float, cycles: int, work) -> list[dict]:
+def arm_plan(
+    seed: int, budget: int, goal: str, bound: float, cycles: int, work, truth=None,
+    spread_boots: int = 8,
+) -> list[dict]:  # fmt: skip
+    """The loop's curve rows; for the map goal (``truth`` given) each row also has the
+    bootstrap spread of the map error (`error_spread`) and the loop's stop signal."""
     opts = LoopOptions(goal=goal, bound=bound, budget_cycles=budget, seed=seed, cycles=cycles)
-    loop = run_loop(Store(work / "plan.duckdb"), opts, out=work / "plan")
-    return [
+    store = Store(work / "plan.duckdb")
+    loop = run_loop(store, opts, out=work / "plan")
+    rows = [
         {
             "cycles": it.cycles_recorded,
             "best_forward_mm": it.achieved_forward_mm,
             "map_error_mm": it.map_error,
+            "stop": bool(it.stop),
+            "trial": f"{it.trial['gait']}@{it.trial['frequency_hz']:g}",
         }
         for it in loop.iterations
     ]
+    if truth is not None:
+        samples = get_version(store, loop.prep_version).samples()
+        trial_ids = [it.trial_id for it in loop.iterations]
+        for k, row in enumerate(rows):
+            part = samples[samples["trial_id"].isin(trial_ids[: k + 1])]
+            key = derive_seed("flat", seed, k)
+            row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
+    return rows
+
+
+def error_spread(samples: pd.DataFrame, truth: TargetTruth, seed: int, n_boot: int = 8) -> float:
+    """Bootstrap standard deviation (mm) of GMR's error on the unseen gaits: GMR refitted
+    on ``n_boot`` cycle-block resamples of ``samples`` (`suds_exp.plan.ensemble`)."""
+    errors = [truth.map_error(fit_map(f)) for f in block_draws(samples, n_boot, seed)]
+    return float(np.std(errors, ddof=1))
+
+
+def flattening(rows: list[dict]) -> dict:
+    """Where the measured map-error curve flattens and where the stop signal first fired.
+
+    Flattens at c: the first recorded count c for which the curve reaches 2 c and the
+    error at the first count >= 2 c is lower than at c by less than the bootstrap spread
+    of the error at c. The signal is within 20 % when |fired - c| <= 0.2 c."""
+    flat = None
+    for r in rows:
+        later = [q for q in rows if q["cycles"] >= 2 * r["cycles"]]
+        if r["cycles"] <= 0 or not later:
+            continue
+        drop = r["map_error_mm"] - later[0]["map_error_mm"]
+        if drop < r["error_spread_mm"]:
+            flat = {"cycles": r["cycles"], "drop_mm": drop, "spread_mm": r["error_spread_mm"],
+                    "doubled_at": later[0]["cycles"]}  # fmt: skip
+            break
+    fired = next((r["cycles"] for r in rows if r["stop"]), None)
+    within = None
+    if flat is not None and fired is not None:
+        within = abs(fired - flat["cycles"]) <= 0.2 * flat["cycles"]
+    return {"flattens_at": flat, "signal_first_at": fired, "within_20_percent": within}
 
 
 def measured_forward(gait, cycles: int, seed: int, config: SimConfig) -> float:
@@ -201,17 +253,40 @@ def arm_designer(seed: int, bound: float, truth: TargetTruth, work: Path) -> dic
     }
 
 
+def arm_fullgrid(seed: int, truth: TargetTruth, work: Path) -> dict:
+    """GMR's error on the unseen gaits learned from the paper's full grid (the map goal's
+    bar) and the grid's cycles."""
+    store = Store(work / "grid.duckdb")
+    ds = simulate_dataset(work / "grid", seed=seed)
+    ingest_paths(store, [], manifest=ds.manifest, progress=False)
+    preprocess(store, progress=False)
+    cycles = int(round(sum(s.n_cycles for s in plan_trials(seed=seed))))
+    samples = get_version(store).samples()
+    error = truth.map_error(fit_map(samples))
+    spread = error_spread(samples, truth, derive_seed("flat-grid", seed))
+    return {"cycles": cycles, "map_error_mm": error, "error_spread_mm": spread}
+
+
 def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[list[dict], float]:
     """One arm's curve rows on dataset ``seed`` within ``budget`` cycles, and its wall s."""
     started = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
+        if arm == "plan":
+            # kept: a plan loop stopped half-way continues where it ended when run again
+            work = args.out / f"work-{goal}-plan-s{seed}"
+            work.mkdir(parents=True, exist_ok=True)
         if arm == "grid":
             rows = arm_grid(seed, budget, truth, work)
         elif arm == "random":
             rows = arm_random(seed, budget, args.cycles, args.bound, truth, work)
         elif arm == "plan":
-            rows = arm_plan(seed, budget, goal, args.bound, args.cycles, work)
+            rows = arm_plan(
+                seed, budget, goal, args.bound, args.cycles, work,
+                truth if goal == "map" else None, args.spread_boots,
+            )  # fmt: skip
+        elif arm == "fullgrid":
+            rows = [arm_fullgrid(seed, truth, work)]
         elif arm == "bo":
             rows = arm_bo(seed, args.bo_budget, args.cycles, args.bound)
         else:
@@ -238,6 +313,14 @@ def main() -> None:
     ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
     ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms ('' for none)")
     ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
+    ap.add_argument(
+        "--spread-boots", type=int, default=8,
+        help="bootstrap refits of the map error's spread (the flattening check)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--map-arms", default="grid,random,plan",
+        help="map-goal arms (grid, random, plan, fullgrid: the full grid's error alone)",
+    )  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("reports/adaptive"))
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
@@ -264,7 +347,8 @@ def main() -> None:
             summary["arms"].setdefault(arm, {})[str(seed)] = entry
             print(f"gait seed {seed} {arm}: {entry}", flush=True)
             save(curves, summary, args.out)
-        for arm in ("grid", "random", "plan") if args.map_budget > 0 else ():
+        map_arms = [a for a in args.map_arms.split(",") if a]
+        for arm in map_arms if args.map_budget > 0 else ():
             rows, seconds = run_arm(arm, "map", seed, args.map_budget, args, truth)
             curves += [{"goal": "map", "arm": arm, "seed": seed} | r for r in rows]
             entry = {
@@ -272,6 +356,10 @@ def main() -> None:
                 "map_error_mm": round(rows[-1]["map_error_mm"], 3),
                 "seconds": round(seconds, 1),
             }
+            if "error_spread_mm" in rows[-1]:
+                entry["error_spread_mm"] = round(rows[-1]["error_spread_mm"], 3)
+            if arm == "plan":
+                entry["flattening"] = flattening(rows)
             summary.setdefault("map", {}).setdefault(arm, {})[str(seed)] = entry
             print(f"map seed {seed} {arm}: {entry}", flush=True)
             save(curves, summary, args.out)
@@ -293,6 +381,7 @@ def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
     import matplotlib.pyplot as plt
 
     colours = {"grid": "C0", "random": "C1", "plan": "C2", "bo": "C3", "designer": "C4"}
+    colours["fullgrid"] = "C0"
     for goal, column, label in (
         ("gait", "best_forward_mm", "best gait on the simulator (share of the ceiling)"),
         ("map", "map_error_mm", "GMR error on the unseen gaits (mm per cycle)"),

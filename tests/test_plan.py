@@ -87,6 +87,28 @@ def test_next_map_recommends_declared_levels_with_reasons_and_a_stop_signal(db, 
     assert len(stop["cycles"]) == 2 and stop["message"].split(":")[0] in ("stop", "continue")
 
 
+def test_the_map_criterion_discounts_what_is_recorded_and_spreads_a_batch(small):
+    from suds_exp.plan import MapEnsemble
+    from suds_exp.plan.recommend import recommend_map
+    from suds_exp.preprocess import get_version
+
+    samples = get_version(Store(small), "v1").samples()  # ten cycles of O at 1/2 Hz
+    ensemble = MapEnsemble.fit(samples, n_boot=3, seed=0)
+    target = Target()
+
+    blind = recommend_map(ensemble, target, 10, n=15)
+    seen = recommend_map(ensemble, target, 10, n=15, samples=samples)
+    # the same variance, but the ten recorded cycles of O near the target's paths take a
+    # share of what any new trial there would remove
+    assert 0 < seen[0].score < blind[0].score
+    assert "cycles are recorded on average" in seen[0].reason
+    # a batch: fifteen different trials, each scored as if the ones before were recorded
+    picks = [(r.trial.gait.name, r.trial.frequency_hz) for r in seen]
+    assert len(set(picks)) == 15
+    scores = [r.score for r in seen]
+    assert scores == sorted(scores, reverse=True)
+
+
 def test_next_gait_writes_a_new_gait_file_within_the_bound(db, tmp_path):
     target = Target.of(bound=1.2)
     advice = plan_next(
@@ -238,11 +260,28 @@ def test_run_report_and_findings_work_on_the_version_after_a_gait_loop(gait_loop
     store = Store(db)
     added = store.query_df("SELECT level FROM experiment_levels WHERE added_by LIKE 'plan loop%'")
     assert len(added) >= 1
-    # the warm-up is one trial of a declared level (O at 1/2 Hz), which a same-condition
-    # pair cannot use: a plain run refuses it naming --skip-infeasible, as for any data
-    ok(
-        "run", "after", "--models", "GMR", "--boots", "1", "--train-cycles", "3",
-        "--skip-infeasible", "--db", str(db), "-q",
-    )  # fmt: skip
+    # the warm-up (one short trial of O at 1/2 Hz) and the designed gait's trial cannot
+    # form a same-condition pair; the loop chose and recorded both, so a plain run
+    # leaves those cells out and says so, as it does for any added level
+    args = ("--models", "GMR", "--boots", "1", "--train-cycles", "3", "--db", str(db))
+    out = ok("run", "after", *args, "-q")
+    assert "left out:" in out and "O@0.5" in out
     ok("report", "after", "--out", str(tmp_path / "report"), "--db", str(db))
     ok("findings", "after", "--db", str(db))
+
+
+def test_run_after_a_map_loop_leaves_out_only_what_the_loop_recorded(tmp_path):
+    db = tmp_path / "m.duckdb"
+    run_loop(Store(db), tiny(goal="map", budget_cycles=13, seed=2), out=tmp_path / "o")
+    args = ("--models", "GMR", "--boots", "1", "--train-cycles", "3", "--db", str(db))
+    out = ok("run", "m", *args, "-q")
+    assert "left out:" in out
+    # a declared condition the user recorded is not excused: one short trial of S+ of
+    # the user's own is refused as before, naming --skip-infeasible
+    ok(
+        "simulate", "--out", str(tmp_path / "d"), "--gaits", "S+", "--freqs", "1",
+        "--repeats", "1", "--cycles", "4", "--ingest", "--db", str(db), "-q",
+    )  # fmt: skip
+    ok("preprocess", "--db", str(db), "-q")
+    r = runner.invoke(app, ["run", "m2", *args])
+    assert r.exit_code != 0 and "skip-infeasible" in r.stderr

@@ -157,7 +157,7 @@ def make_plan(
     options: CampaignOptions,
     available: list[Condition],
     bank_for,
-    added: frozenset[str] = frozenset(),
+    added: frozenset = frozenset(),
 ) -> tuple[Plan, SampleBank]:
     """Resolve ``options`` (already merged) against the conditions in the samples.
 
@@ -165,8 +165,10 @@ def make_plan(
     definition records its decimation and the trials used. ``added``: labels of
     conditions that code added to the design after its declaration
     (`suds_exp.experiment.ExperimentDesign.added_labels`, e.g. one verify trial of a
-    designed gait each); their cells the data cannot supply are left out, as
-    ``skip_infeasible`` leaves out every condition's.
+    designed gait each), and (label, frequency) conditions whose every trial a planning
+    loop chose and recorded (e.g. its warm-up: one short trial of a declared level);
+    their cells the data cannot supply are left out, as ``skip_infeasible`` leaves out
+    every condition's.
     """
     if not name or not name.strip():
         raise CampaignError("campaign NAME must not be empty")
@@ -209,7 +211,7 @@ def make_plan(
         # an added condition holds the few trials a loop ran (one per designed gait), not
         # the repeats a declared one has: what it cannot supply is left out, and said
         cells = infeasible_cells(bank, train, test, int(options.train_cycles), sweep)
-        skipped = [cell for cell in cells if cell[0][0] in added]
+        skipped = [cell for cell in cells if cell[0][0] in added or cell[0] in added]
     definition = {
         "version": DEFINITION_VERSION,
         "options": stored_options,

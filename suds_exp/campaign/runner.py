@@ -39,6 +39,7 @@ from threadpoolctl import threadpool_limits
 
 from suds_exp.campaign import tables
 from suds_exp.campaign.bank import SampleBank, rounded_conditions
+from suds_exp.campaign.conditions import round_hz
 from suds_exp.campaign.definition import (
     CampaignOptions,
     Plan,
@@ -306,7 +307,7 @@ def run_campaign(
             dataclasses.replace(merged, prep=prep),
             stored,
             samples,
-            stored_design(store).added_labels,
+            stored_design(store).added_labels | planned_conditions(store),
         )
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_chunks(
@@ -314,7 +315,7 @@ def run_campaign(
         )
         if total == 0:
             raise CampaignError(
-                f"campaign {name!r}: skip_infeasible left out every cell ("
+                f"campaign {name!r}: the data cannot supply any cell, all left out ("
                 + skipped_cells_text(plan.definition)
                 + "); lower train_cycles/sweep",
                 param=("skip_infeasible", "train_cycles", "sweep"),
@@ -383,12 +384,37 @@ def campaign_samples(
     return version.name, version.samples()
 
 
+def planned_conditions(store: Store) -> frozenset:
+    """The (gait, frequency_hz) conditions every trial of which a planning loop chose and
+    recorded (``plan_iterations.trial_id``: its warm-up and its trials of declared
+    levels); empty for a store without plan loops."""
+    with store.read() as conn:
+        have = conn.execute(
+            sa.text(
+                "SELECT count(*) FROM information_schema.tables "
+                "WHERE table_name = 'plan_iterations'"
+            )
+        ).scalar()
+        if not have:
+            return frozenset()
+        frame = Store.frame(
+            conn,
+            "SELECT t.gait, t.frequency_hz, bool_and(p.trial_id IS NOT NULL) AS planned "
+            "FROM trials t LEFT JOIN (SELECT DISTINCT trial_id FROM plan_iterations) p "
+            "ON p.trial_id = t.id WHERE t.gait IS NOT NULL AND t.frequency_hz IS NOT NULL "
+            "GROUP BY t.gait, t.frequency_hz",
+        )
+    return frozenset(
+        (str(r.gait), round_hz(r.frequency_hz)) for r in frame.itertuples() if r.planned
+    )
+
+
 def plan_campaign(
     name: str,
     options: CampaignOptions,
     stored: dict | None,
     samples: pd.DataFrame,
-    added: frozenset[str] = frozenset(),
+    added: frozenset = frozenset(),
 ) -> tuple[Plan, SampleBank]:
     """The plan and sample bank of campaign ``name`` with ``options`` (merged with the
     ``stored`` definition; ``options.prep`` the label of ``samples``, see
@@ -413,7 +439,7 @@ def plan_campaign(
     # supply; conditions without any complete cycle are refused either way.
     needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
     # the added conditions' infeasible cells are already left out (`make_plan`)
-    needs = {c: n for c, n in needs.items() if c[0] not in added}
+    needs = {c: n for c, n in needs.items() if c[0] not in added and c not in added}
     check_feasible(bank, plan.train_conditions, plan.test_conditions, needs)
     return plan, bank
 

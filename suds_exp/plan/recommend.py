@@ -4,13 +4,26 @@ Two goals:
 
 - ``"map"``: learn the map well over a target set (`Target`). The candidates are the
   declared levels (the paper's gaits at its frequencies) and the target's own gait files.
-  A trial's value is the expected reduction of the prediction uncertainty over the
-  target: the bootstrap variance (mm^2) of each target's net displacement per cycle,
-  times the share of that target's path the trial would visit (in the (shape, direction
-  of shape velocity) metric of `suds_exp.gait.support`; recorded data make a map's
-  bootstrap spread collapse where they are), summed over the target. A trial at another
-  frequency than a target's counts half for it: the map is rate-independent only as far
-  as the robot is.
+  A trial's value is the expected reduction of the prediction variance integrated over
+  the target's paths. Each target's bootstrap variance (mm^2, net displacement per
+  cycle) is spread evenly over the samples of its path; a path sample's variance falls
+  like that of a local mean, as 1/n in the cycles n recorded near it (each cycle
+  weighted by a Gaussian kernel of its distance in the (shape, direction of shape
+  velocity) metric of `suds_exp.gait.support`), so a trial bringing m such cycles there
+  removes the share m / (n0 + n + m) of it (n0 = `PRIOR_CYCLES`, the prior's worth). The
+  kernel's length-scale is the candidates' spacing (`candidate_spacing`: the widest gap
+  from a candidate's path to its nearest neighbour's): the learner interpolates between
+  neighbouring paths, so a cycle informs the map as far as the next candidate's path.
+  A cycle at another frequency than the target's counts half (the map is
+  rate-independent only as far as the robot is). What is already recorded is so
+  discounted, a path sample far from all data keeps nearly all its variance for the
+  first trial that comes near, and a batch of ``n`` trials is chosen greedily, each
+  scored as if the ones before it were recorded.
+
+  Why not the bootstrap alone: the cycle bootstrap sees the noise of what is recorded,
+  not the bias of a map that has seen only a few paths (after 35 cycles of three gaits
+  its variance over the default target was about 5 mm^2 against a squared error near
+  40 mm^2), so on its own it keeps choosing the paths nearest the target.
 - ``"gait"``: the best forward displacement per cycle within the bound. The next trial is
   a new Fourier gait (written to a file) that maximises the upper confidence bound
   (point prediction + `KAPPA` x bootstrap spread) inside the joint bound and inside a
@@ -24,19 +37,20 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from scipy.spatial import cKDTree
 
 from suds_exp.gait.design import circle, optimise_gait
 from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, paper_gaits, within_bound
-from suds_exp.gait.support import SHAPE_RADIUS, Support, direction_features
+from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns, direction_features
 from suds_exp.plan.ensemble import MapEnsemble
 from suds_exp.plan.target import Target
 from suds_exp.robot import FREQUENCIES_HZ
 
 #: Weight of the bootstrap spread in the gait goal's upper confidence bound.
 KAPPA = 1.0
-#: Share of a target's path a trial visits: its samples within this distance (rad, the
-#: support metric) of the trial's path.
+#: Length-scale (rad, the support metric) of `nearness` when the candidates give none
+#: (a single candidate path): the support's own radius.
 VISIT_RADIUS = SHAPE_RADIUS
 #: Starting lags (rad) of the gait search's circles beside the best recorded gait.
 START_LAGS_RAD = (-0.6, 0.0, 0.6)
@@ -86,45 +100,126 @@ def _path_features(gait: Gait, n: int = 64) -> np.ndarray:
     return direction_features(gait.shape(theta), gait.rate(theta))
 
 
-def visited_share(candidate: Gait, target: Gait) -> float:
-    """Share (0..1) of ``target``'s path within `VISIT_RADIUS` of ``candidate``'s."""
-    d = cKDTree(_path_features(candidate)).query(_path_features(target))[0]
-    return float(np.mean(d <= VISIT_RADIUS))
-
-
 def declared_levels() -> list[tuple[Gait, float]]:
     """The paper's declared levels: every gait at every frequency (Hz), in its order."""
     return [(g, f) for g in paper_gaits() for f in FREQUENCIES_HZ]
 
 
-def recommend_map(
-    ensemble: MapEnsemble, target: Target, cycles: int, n: int = 1
-) -> list[Recommendation]:
-    """The ``n`` trials of ``cycles`` cycles that remove the most bootstrap variance of
-    the target's predictions (see the module docstring), best first."""
+#: The prior's worth in cycles: a path sample's variance is that of a local mean with
+#: this many cycles' precision before any data (so a far trial's tiny weight cannot
+#: claim a whole unvisited sample's variance).
+PRIOR_CYCLES = 1.0
+#: Weight of a recorded or planned cycle at another frequency than a target's.
+OTHER_FREQUENCY_WEIGHT = 0.5
+
+
+def nearness(distance: np.ndarray, scale: float = VISIT_RADIUS) -> np.ndarray:
+    """Weight (0..1) of a cycle at ``distance`` (rad, support metric) from a path sample:
+    exp(-d^2 / 2 scale^2), scale in rad."""
+    return np.exp(-0.5 * (np.asarray(distance, float) / scale) ** 2)
+
+
+def candidate_spacing(gaits: list[Gait], n: int = 64) -> float:
+    """The widest gap (rad, support metric) from a sample of one candidate path to the
+    nearest other candidate path, over the distinct paths of ``gaits``; `VISIT_RADIUS`
+    for fewer than two paths."""
+    paths = {g.name: _path_features(g, n) for g in gaits}
+    if len(paths) < 2:
+        return VISIT_RADIUS
+    widest = 0.0
+    for name, path in paths.items():
+        others = np.vstack([p for k, p in paths.items() if k != name])
+        widest = max(widest, float(cKDTree(others).query(path)[0].max()))
+    return widest or VISIT_RADIUS
+
+
+def _frequency_weight(a: float, b: float) -> float:
+    return 1.0 if math.isclose(a, b) else OTHER_FREQUENCY_WEIGHT
+
+
+def recorded_cycles_near(
+    samples: pd.DataFrame | None, target: Target, n: int = 64, scale: float = VISIT_RADIUS
+) -> np.ndarray:
+    """Recorded cycles near each sample of each target path: (len(target.pairs()), n);
+    scale: `nearness`'s length-scale, rad.
+
+    A trial counts its cycles at each path sample, weighted by `nearness` of its nearest
+    sample and by `OTHER_FREQUENCY_WEIGHT` off the target's frequency."""
     pairs = target.pairs()
+    out = np.zeros((len(pairs), n))
+    if samples is None or samples.empty:
+        return out
+    paths = [_path_features(g, n) for g, _ in pairs]
+    ra_cols, dra_cols = actuated_columns(samples)
+    for _, trial in samples.groupby("trial_id"):
+        feats = direction_features(trial[ra_cols].to_numpy(float), trial[dra_cols].to_numpy(float))
+        tree = cKDTree(feats)
+        cycles = float(trial["cycle"].nunique())
+        freq = float(trial["frequency_hz"].iloc[0])
+        for k, ((_, f), path) in enumerate(zip(pairs, paths, strict=True)):
+            near = nearness(tree.query(path)[0], scale)
+            out[k] += cycles * _frequency_weight(freq, f) * near
+    return out
+
+
+def recommend_map(
+    ensemble: MapEnsemble,
+    target: Target,
+    cycles: int,
+    n: int = 1,
+    samples: pd.DataFrame | None = None,
+) -> list[Recommendation]:
+    """The ``n`` trials of ``cycles`` cycles that remove the most prediction variance
+    integrated over the target's paths (see the module docstring), chosen greedily, in
+    that order. ``samples``: the recorded data (the version's frame) whose cycles near
+    each path sample discount a new trial's; None counts none."""
+    pairs = target.pairs()
+    n_path = 64
     variance = np.array([ensemble.displacement_spread([g], f)[0] for g, f in pairs])
+    per_sample = np.repeat(variance[:, None] / n_path, n_path, axis=1)
     candidates = declared_levels() + [
         (g, f)
         for g, file in zip(target.gaits, target.files, strict=False)
         for f in target.frequencies_hz
     ]
-    recs = []
+    scale = candidate_spacing([g for g, _ in candidates], n_path)
+    recorded = recorded_cycles_near(samples, target, n_path, scale)
+    paths = [_path_features(g, n_path) for g, _ in pairs]
+    brings, reach = [], []
     for gait, freq in candidates:
-        shares = np.array(
-            [visited_share(gait, g) * (1.0 if math.isclose(f, freq) else 0.5) for g, f in pairs]
+        tree = cKDTree(_path_features(gait, n_path))
+        visited = np.array([nearness(tree.query(path)[0], scale) for path in paths])
+        weights = np.array([_frequency_weight(freq, f) for _, f in pairs])
+        brings.append(cycles * weights[:, None] * visited)
+        reach.append(int(np.sum(visited.max(axis=1) > 0.5)))
+    recs: list[Recommendation] = []
+    taken: set[int] = set()
+    for _ in range(min(n, len(candidates))):
+        removed = np.array(
+            [
+                float(np.sum(per_sample * m / (PRIOR_CYCLES + recorded + m)))
+                if i not in taken
+                else -np.inf
+                for i, m in enumerate(brings)
+            ]
         )
-        removed = float(np.sum(variance * shares))
-        covered = int(np.sum(shares > 0))
-        file = _file_of(gait, target)
-        trial = Trial(gait, freq, cycles, file)
+        i = int(np.argmax(removed))
+        m = brings[i]
+        near = recorded[m > 0.5 * m.max()]
+        gait, freq = candidates[i]
+        covered = reach[i]
         reason = (
-            f"expected to remove {removed:.2f} mm^2 of the target's prediction variance "
-            f"({covered} of {len(pairs)} targets visited; total {variance.sum():.2f} mm^2)"
+            f"expected to remove {removed[i]:.2f} mm^2 of the target's prediction variance "
+            f"of {per_sample.sum():.2f} ({covered} of {len(pairs)} targets visited, where "
+            f"{float(near.mean()) if near.size else 0.0:.1f} cycles are recorded on average)"
         )
-        recs.append(Recommendation(trial, removed, "mm^2", reason))
-    recs.sort(key=lambda r: -r.score)
-    return recs[:n]
+        trial = Trial(gait, freq, cycles, _file_of(gait, target))
+        recs.append(Recommendation(trial, float(removed[i]), "mm^2", reason))
+        # the next pick is scored as if this one were recorded
+        per_sample = per_sample * (PRIOR_CYCLES + recorded) / (PRIOR_CYCLES + recorded + m)
+        recorded = recorded + m
+        taken.add(i)
+    return recs
 
 
 def _file_of(gait: Gait, target: Target) -> str | None:
