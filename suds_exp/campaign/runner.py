@@ -166,23 +166,50 @@ def pending_jobs(store: Store, plan: Plan, chunk_jobs: int) -> tuple[Iterator[Ch
 
 def _pending_codes(raw, plan: Plan, cells: list, names: list[str], total: int) -> np.ndarray:
     """Codes ((cell rank x boots + boot) x learners + learner rank) of the jobs of the grid
-    with no row in `results`, ascending (int64, shape (pending,))."""
+    with no row in `results`, ascending (int64, shape (pending,)).
+
+    First the finished jobs are counted per (cell, learner), one pass over the campaign's
+    rows grouped into as many groups as the grid has cells; a finished campaign ends
+    there. Only the cells with jobs left then go through the anti-join.
+    """
     if not raw.execute(
         "SELECT count(*) FROM information_schema.tables WHERE table_name = 'results'"
     ).fetchone()[0]:
         return np.arange(total, dtype=np.int64)
+    nm, boots = len(names), plan.boots
+    # Each key is stored once (the unique key on `results`), so rows count distinct jobs.
+    counts = raw.execute(
+        "SELECT train_gait, train_frequency_hz, test_gait, test_frequency_hz, n_cycles, "
+        "model, count(*) FILTER (WHERE boot >= 0 AND boot < $boots) AS done "
+        "FROM results WHERE campaign = $name GROUP BY ALL",
+        {"boots": boots, "name": plan.name},
+    ).fetchall()
+    rank = {(tr[0], tr[1], te[0], te[1], n): i for i, (tr, te, n) in enumerate(cells)}
+    learner = {m: k for k, m in enumerate(names)}
+    done = np.zeros((len(cells), nm), dtype=np.int64)
+    for *cell, model, n_done in counts:
+        i, k = rank.get(tuple(cell)), learner.get(model)
+        if i is not None and k is not None:
+            done[i, k] = n_done
+    if done.sum() == 0:
+        return np.arange(total, dtype=np.int64)
+    open_cells = np.flatnonzero((done < boots).any(axis=1))
+    if len(open_cells) == 0:
+        return np.empty(0, dtype=np.int64)
     frame = pd.DataFrame(
-        [(i, tr[0], tr[1], te[0], te[1], n) for i, (tr, te, n) in enumerate(cells)],
+        [(int(i), *cells[i][0], *cells[i][1], cells[i][2]) for i in open_cells],
         columns=["rank", "tg", "tf", "dg", "df", "n"],
     )
-    learners = pd.DataFrame({"rank": range(len(names)), "model": names})
     tag = next(_frame_tags)
     raw.register(f"_suds_cells_{tag}", frame)
-    raw.register(f"_suds_learners_{tag}", learners)
-    # Each key is stored once (the unique key on `results`), so counting the finished
-    # jobs of the grid counts distinct jobs.
-    done = f"""
-        SELECT (c.rank * $boots + r.boot) * $nm + m.rank AS code
+    raw.register(f"_suds_learners_{tag}", pd.DataFrame({"rank": range(nm), "model": names}))
+    code = "(c.rank * $boots + {boot}) * $nm + m.rank"
+    grid = (
+        f"SELECT {code.format(boot='b.boot')} AS code FROM _suds_cells_{tag} c, "
+        f"range($boots) b(boot), _suds_learners_{tag} m"
+    )
+    finished = f"""
+        SELECT {code.format(boot="r.boot")} AS code
         FROM results r
         JOIN _suds_cells_{tag} c
           ON r.train_gait = c.tg AND r.train_frequency_hz = c.tf
@@ -190,17 +217,11 @@ def _pending_codes(raw, plan: Plan, cells: list, names: list[str], total: int) -
         JOIN _suds_learners_{tag} m ON r.model = m.model
         WHERE r.campaign = $name AND r.boot >= 0 AND r.boot < $boots
     """
-    params = {"boots": plan.boots, "nm": len(names), "name": plan.name}
     try:
-        (finished,) = raw.execute(f"SELECT count(*) FROM ({done})", params).fetchone()
-        if finished == 0:
-            return np.arange(total, dtype=np.int64)
-        if finished >= total:
-            return np.empty(0, dtype=np.int64)
         left = raw.execute(
-            f"SELECT g.code FROM range($total) g(code) ANTI JOIN ({done}) d ON g.code = d.code "
+            f"SELECT g.code FROM ({grid}) g ANTI JOIN ({finished}) d ON g.code = d.code "
             "ORDER BY g.code",
-            {**params, "total": total},
+            {"boots": boots, "nm": nm, "name": plan.name},
         ).fetchnumpy()["code"]
     finally:
         raw.unregister(f"_suds_cells_{tag}")
