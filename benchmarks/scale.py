@@ -12,8 +12,9 @@ slices of draws, each slice its own seed) and whose definition is stored by
 `run_campaign` on synthetic-swimmer samples of the same 15 conditions (so a re-run is a
 real resume that finds nothing left).
 
-Then each command runs in its own process, ``--rounds`` times, and its wall time and
-peak resident memory (the process's ru_maxrss) are recorded:
+Then each command runs in its own process, ``--rounds`` times, and its wall time, CPU
+time (user + system, every thread: less sensitive than wall time to a shared machine's
+load) and peak resident memory (the process's ru_maxrss) are recorded:
 
 - ``report``: ``suds-exp report scale --out DIR`` (its default bootstrap);
 - ``findings``: ``suds-exp findings scale --boots B`` (``--findings-boots``, default 400);
@@ -99,11 +100,11 @@ def resume_worker(db: Path) -> dict:
     from suds_exp.store import Store
 
     samples = scale_samples()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     summary = run_campaign(Store(db), CAMPAIGN, samples=samples, progress=False)
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     assert summary.remaining == 0 and summary.done_now == 0, summary
-    return {"seconds": seconds, "jobs": summary.total_jobs}
+    return {"seconds": seconds, "cpu_s": cpu, "jobs": summary.total_jobs}
 
 
 def command(name: str, db: Path, out: Path, findings_boots: int) -> list[str]:
@@ -142,8 +143,10 @@ def measure_child(argv: list[str]) -> dict:
         raise SystemExit(proc.returncode)
     import resource
 
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
-    figures = {"seconds": wall, "peak_mb": peak}
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    peak = usage.ru_maxrss / 1024
+    # CPU time (all threads) says less about the machine's load than wall time
+    figures = {"seconds": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "peak_mb": peak}
     if "--resume-worker" in argv:
         figures.update(json.loads(out.decode().splitlines()[-1]))
     return figures
@@ -194,11 +197,13 @@ def main(argv=None) -> int:
                 figures = run_measured(command(name, db, out, a.findings_boots))
                 runs.append(figures)
                 print(
-                    f"  {size:g}M {name}: {figures['seconds']:.1f} s, {figures['peak_mb']:.0f} MB",
+                    f"  {size:g}M {name}: {figures['seconds']:.1f} s "
+                    f"(CPU {figures['cpu_s']:.1f} s), {figures['peak_mb']:.0f} MB",
                     file=sys.stderr,
                 )
             table[size][name] = {
                 "seconds": statistics.median(r["seconds"] for r in runs),
+                "cpu_s": statistics.median(r["cpu_s"] for r in runs),
                 "peak_mb": statistics.median(r["peak_mb"] for r in runs),
                 "runs": runs,
             }
