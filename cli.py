@@ -707,7 +707,7 @@ def status(
         print_status(report)
 
 
-@command(flags={"n_cycles": "--cycles", "paper_dir": "--paper"})
+@command(flags={"n_cycles": "--cycles", "paper_dir": "--paper", "n_boot": "--boots"})
 def report(
     name: CampaignArgument,
     out: Annotated[Path | None, typer.Option(help="Folder (default: reports/NAME).")] = None,
@@ -724,6 +724,9 @@ def report(
         Path | None,
         typer.Option(help="TOML of the condition axes (default: the one stored at ingest)."),
     ] = None,
+    boots: Annotated[
+        int, typer.Option(help="Bootstrap replicates of the findings' intervals.")
+    ] = 400,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -740,7 +743,14 @@ def report(
 
     design = load_design(experiment) if experiment is not None else None
     index = write_report(
-        open_store(db), name, out, paper_dir=paper, n_cycles=cycles, pairs=pairs, design=design
+        open_store(db),
+        name,
+        out,
+        paper_dir=paper,
+        n_cycles=cycles,
+        pairs=pairs,
+        design=design,
+        n_boot=boots,
     )
     if json_:
         console.print_json(report_document(index))

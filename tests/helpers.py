@@ -45,6 +45,7 @@ SLOW_FILES = (
     "test_analysis_report.py",
     "test_preprocess_reduction.py",
     "test_campaign_runner.py",
+    "test_campaign_resume.py",
     "test_body_segments.py",
     "test_models_sklearn.py",
     "test_stream.py",

@@ -128,12 +128,29 @@ def test_user_errors_exit_2_with_one_line(report, tmp_path):
             "pass --paper",
         ),
         (["report", "a/b", "--db", db], "safe folder name"),
+        (["report", "demo", "--db", db, "--out", tmp_path / "e", "--boots", "-1"], "--boots -1"),
     ]
     for args, message in cases:
         result = cli(*args)
         assert result.exit_code == 2, (args, result.output)
         assert message in result.output, (message, result.output)
         assert len(result.output.strip().splitlines()) == 1
+
+
+def test_boots_sets_the_findings_replicates(report, tmp_path):
+    """--boots 0: the findings without intervals (the default has them), the rest alike."""
+    result = cli("report", "demo", "--db", report["db"], "--out", tmp_path, "--boots", "0")
+    assert result.exit_code == 0, result.output
+    quick = pd.read_csv(tmp_path / "findings.csv")
+    default = pd.read_csv(report["index"].parent / "findings.csv")
+    measured = default["low"].notna()
+    assert measured.any() and quick.loc[measured, "low"].isna().all()
+    pd.testing.assert_series_equal(quick["value"], default["value"])
+    for name in ("glm", "categories", "iqr"):
+        pd.testing.assert_frame_equal(
+            pd.read_csv(tmp_path / f"{name}.csv"),
+            pd.read_csv(report["index"].parent / f"{name}.csv"),
+        )
 
 
 def _browser() -> str | None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import signal
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -117,3 +118,56 @@ def test_a_run_stopped_inside_a_chunk_resumes_with_every_row_once(tmp_path, monk
     again = run_campaign(store, "c", samples=samples, progress=False)
     assert again.done_before == 6 and again.done_now == again.total_jobs - 6
     pd.testing.assert_frame_equal(campaign_rows(store), campaign_rows(full), check_exact=True)
+
+
+_FAULTS = """
+import resource, sys, threading
+import numpy as np
+from suds_exp.campaign.job import settle_allocator
+
+def arrays(out):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    for _ in range(200):
+        a = np.ones(100_000)  # 800 KB, as a job's frames
+        b = a * 2
+        del a, b
+    out.append(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
+
+def in_a_thread():  # a dask worker runs its tasks in a thread
+    out = []
+    t = threading.Thread(target=arrays, args=(out,))
+    t.start()
+    t.join()
+    return out[0]
+
+in_a_thread()
+fixed = in_a_thread()
+settled = settle_allocator()
+in_a_thread()
+print(fixed, settled, in_a_thread())
+"""
+
+
+def test_a_worker_with_the_nannys_trim_threshold_stops_faulting_its_arrays_in(tmp_path):
+    """dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536; then each array of a
+    job in the worker's task thread faults its pages in anew, until the allocator is
+    settled (page faults counted, not timed)."""
+    import os
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    for trim, expect_settled in (("65536", True), (None, False)):
+        env.pop("MALLOC_TRIM_THRESHOLD_", None)
+        if trim:
+            env["MALLOC_TRIM_THRESHOLD_"] = trim
+        out = subprocess.run(
+            [sys.executable, "-c", _FAULTS], env=env, capture_output=True, text=True, check=True
+        )
+        fixed, settled, after = out.stdout.split()
+        assert (settled == "True") is expect_settled
+        if trim:
+            assert int(fixed) > 20_000 and int(after) < 1_000, out.stdout
+        else:
+            assert int(fixed) < 1_000, out.stdout

@@ -256,11 +256,13 @@ def _f10(d: _Data) -> float:
 
 @dataclass
 class _GlmDesign:
-    """The GLM's design matrices (direct, interactions), rows tied to draws."""
+    """The GLM's designs (direct, interactions) as distinct rows and each row's pattern
+    (`formula_design`), rows tied to draws."""
 
     draw: np.ndarray  # draw index of each row
     y: np.ndarray
-    exog: dict[str, np.ndarray]
+    patterns: dict[str, np.ndarray]  # (k, q) distinct rows of the identifiable columns
+    pattern: dict[str, np.ndarray]  # (n,) each row's pattern
     columns: dict[str, list[str]]
 
 
@@ -270,13 +272,14 @@ def _glm_design(labelled: pd.DataFrame, draw_index: pd.Series, main: int) -> _Gl
     if len(frame) < 10 or frame["suds"].nunique() < 2 or frame["gmr"].nunique() < 2:
         return None
     direct, interactions, _ = glm_formulas(frame)
-    exog, columns = {}, {}
+    patterns, pattern, columns = {}, {}, {}
     for label, formula in (("direct", direct), ("interactions", interactions)):
         design = formula_design(formula, frame)
-        exog[label] = design.exog[:, design.keep]
+        patterns[label] = design.patterns[:, design.keep]
+        pattern[label] = design.pattern
         columns[label] = [design.names[j] for j in design.keep]
     draw = draw_index.loc[frame.index].to_numpy()
-    return _GlmDesign(draw, frame["y"].to_numpy(), exog, columns)
+    return _GlmDesign(draw, frame["y"].to_numpy(), patterns, pattern, columns)
 
 
 def _glm_coef(label: str, term: str) -> Callable[[_Data], float]:
@@ -293,10 +296,13 @@ def _glm_coef(label: str, term: str) -> Callable[[_Data], float]:
             # A bootstrap replicate is the full design with each row weighted by how often
             # its draw was drawn: weighted normal equations, identical to refitting on the
             # resampled rows and far cheaper than building their design again.
-            x = g.exog[label]
+            # The rows of a pattern share their design row, so the normal equations
+            # need only each pattern's total weight and weighted response.
+            u, rows = g.patterns[label], g.pattern[label]
             w = np.ones(len(g.y)) if d.weights is None else d.weights[g.draw]
-            xtw = x.T * w
-            d.fits[label] = np.linalg.lstsq(xtw @ x, xtw @ g.y, rcond=None)[0]
+            weight = np.bincount(rows, weights=w, minlength=len(u))
+            wy = np.bincount(rows, weights=w * g.y, minlength=len(u))
+            d.fits[label] = np.linalg.lstsq((u.T * weight) @ u, u.T @ wy, rcond=None)[0]
         return float(d.fits[label][g.columns[label].index(term)])
 
     return compute

@@ -155,6 +155,7 @@ def write_report(
     upper_from: int | None = None,
     pairs: str = "same-condition",
     design: ExperimentDesign | None = None,
+    n_boot: int = 400,
 ) -> Path:
     """Write the report of ``campaign`` into ``out_dir`` (default ``reports/<campaign>``).
 
@@ -184,11 +185,16 @@ def write_report(
         overrides (keeping the levels code added to it, `suds_exp.ingest.design_for`).
         The paper's: this report; another writes
         `suds_exp.analysis.design_report.write_design_report`.
+    n_boot : int
+        Bootstrap replicates of the findings' intervals and of what the passive shape
+        adds (`findings_table`, `passive_information`); 0: no intervals.
 
     Returns
     -------
     Path of ``index.html``.
     """
+    if not isinstance(n_boot, int) or n_boot < 0:
+        raise AnalysisError(f"n_boot {n_boot!r}: expected an integer >= 0", param="n_boot")
     out = _report_folder(campaign, out_dir)
     design = design_for(store, design)
     if not is_paper(design):
@@ -196,7 +202,7 @@ def write_report(
     results = load_results(store, campaign)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)
-    tables = report_tables(results, size, paper_dir, upper_from, pairs)
+    tables = report_tables(results, size, paper_dir, upper_from, pairs, n_boot)
 
     figures = plots.category_boxplots(results, out, size)
     if "iqr" in tables:
@@ -206,7 +212,7 @@ def write_report(
 
     files = _write_tables(tables, out)
     page = _page(campaign, store, results, size, tables, figures, files, pairs)
-    passive = campaign_passive_information(store, campaign)
+    passive = campaign_passive_information(store, campaign, n_boot=n_boot)
     passive_files = (
         write_table(passive, out, "passive_information", 3, to_markdown(passive_display(passive)))
         if not passive.empty

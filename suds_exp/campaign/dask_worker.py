@@ -2,7 +2,9 @@
 
 A terminal's Ctrl-C reaches the whole process group, workers included; the campaign's
 own process stops the run and closes the cluster, so a worker ignores SIGINT instead of
-printing its own KeyboardInterrupt traceback.
+printing its own KeyboardInterrupt traceback. Its allocator is settled before any job
+(`suds_exp.campaign.job.settle_allocator`: the nanny's fixed trim threshold costs page
+faults in every job).
 """
 
 from __future__ import annotations
@@ -15,6 +17,9 @@ def dask_setup(worker) -> None:
     """Called by dask in each worker process as it starts."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from suds_exp.campaign.job import settle_allocator
+
+    settle_allocator()
 
 
 # importing happens before dask_setup, as early as a worker can act

@@ -99,31 +99,43 @@ def enumerate_draws(
     sweep: list[int],
     skip=(),
 ) -> list[Draw]:
-    """Every draw of the campaign grid (main grid, then the sweep), in a fixed order.
+    """Every draw of the campaign grid (main grid, then the sweep), in a fixed order:
+    each cell of `enumerate_cells` with its ``boots`` draws in turn.
 
     ``skip``: (train condition, n_cycles, scope) cells to leave out (see the module
     docstring); scope is ``same-condition`` or ``all``.
     """
-    draws = [
-        Draw(campaign, tr, te, b, train_cycles)
-        for tr in train_conditions
-        for te in test_conditions
+    return [
+        Draw(campaign, tr, te, b, n)
+        for tr, te, n in enumerate_cells(
+            train_conditions, test_conditions, train_cycles, sweep, skip
+        )
         for b in range(boots)
     ]
+
+
+def enumerate_cells(
+    train_conditions: list[Condition],
+    test_conditions: list[Condition],
+    train_cycles: int,
+    sweep: list[int],
+    skip=(),
+) -> list[tuple[Condition, Condition, int]]:
+    """The grid's cells (train condition, test condition, training cycles), main grid
+    then sweep, in `enumerate_draws`'s order; a cell holds one draw per bootstrap index.
+
+    A campaign's draws are its cells times its bootstraps, so code that works on the
+    cells (the runner's pending jobs) never has to build every draw.
+    """
+    cells = [(tr, te, train_cycles) for tr in train_conditions for te in test_conditions]
     same = [c for c in train_conditions if c in set(test_conditions)]
-    draws += [
-        Draw(campaign, c, c, b, n)
-        for c in same
-        for n in sweep
-        if n != train_cycles
-        for b in range(boots)
-    ]
+    cells += [(c, c, n) for c in same for n in sweep if n != train_cycles]
     if skip:
-        cells = {(tuple(c), int(n), scope) for c, n, scope in skip}
-        draws = [
-            d
-            for d in draws
-            if (d.train, d.n_cycles, "all") not in cells
-            and not (d.train == d.test and (d.train, d.n_cycles, "same-condition") in cells)
+        left_out = {(tuple(c), int(n), scope) for c, n, scope in skip}
+        cells = [
+            (tr, te, n)
+            for tr, te, n in cells
+            if (tr, n, "all") not in left_out
+            and not (tr == te and (tr, n, "same-condition") in left_out)
         ]
-    return draws
+    return cells

@@ -18,6 +18,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import dataclasses
+import itertools
 import json
 import logging
 import math
@@ -33,6 +34,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 from threadpoolctl import threadpool_limits
@@ -48,7 +50,7 @@ from suds_exp.campaign.definition import (
     normalise,
     skipped_cells_text,
 )
-from suds_exp.campaign.grid import enumerate_draws
+from suds_exp.campaign.grid import Draw, enumerate_cells
 from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
 from suds_exp.campaign.lock import RunLock
 from suds_exp.campaign.sampling import check_feasible
@@ -171,32 +173,13 @@ def _stored_definition(conn: sa.Connection, name: str) -> dict | None:
     return None if row is None else normalise(json.loads(row[0]))
 
 
-_FINISHED_SQL = (
-    "SELECT model, train_gait, train_frequency_hz, test_gait, test_frequency_hz, boot, "
-    "n_cycles FROM results WHERE campaign = ?"
-)
+def pending_jobs(store: Store, plan: Plan, chunk_jobs: int) -> tuple[Iterator[Chunk], int, int]:
+    """The jobs of ``plan`` not in `results` yet, in chunks of about ``chunk_jobs`` jobs.
 
-
-def finished_keys(store: Store, name: str) -> set[tuple]:
-    """Job keys (model, train gait, train Hz, test gait, test Hz, boot, n_cycles) done."""
-    with store.read() as conn:
-        return _finished_keys(conn, name)
-
-
-def _finished_keys(conn: sa.Connection, name: str) -> set[tuple]:
-    frame = Store.frame(conn, _FINISHED_SQL, [name])
-    return set(zip(*(frame[c].tolist() for c in frame.columns), strict=True))
-
-
-def stored_state(store: Store, name: str) -> tuple[dict | None, set[tuple]]:
-    """(`load_stored_definition`, `finished_keys`) of campaign ``name``, read through one
-    connection (opening the file is most of a small read's cost)."""
-    with store.read() as conn:
-        return _stored_definition(conn, name), _finished_keys(conn, name)
-
-
-def pending_chunks(plan: Plan, done: set[tuple], chunk_jobs: int) -> tuple[list[Chunk], int, int]:
-    """Chunks of (draw, learners still to run) holding about ``chunk_jobs`` jobs each.
+    The set difference (every job of the grid minus the finished ones) is an anti-join in
+    DuckDB on job codes; only the codes of the jobs left come back (8 bytes a job), and
+    draws are built from them as the chunks are consumed. So a resume costs time and
+    memory in the work left, not in the work done: a finished campaign is one count.
 
     Draws with the most training cycles come first (longest jobs first), so the last
     tasks of a run are short and no worker idles long at the end; the order changes no
@@ -204,36 +187,109 @@ def pending_chunks(plan: Plan, done: set[tuple], chunk_jobs: int) -> tuple[list[
 
     Returns (chunks, total jobs of the campaign, pending jobs).
     """
-    draws = enumerate_draws(
-        plan.name,
-        plan.train_conditions,
-        plan.test_conditions,
-        plan.boots,
-        plan.train_cycles,
-        plan.sweep,
-        plan.skipped,
+    cells = enumerate_cells(
+        plan.train_conditions, plan.test_conditions, plan.train_cycles, plan.sweep, plan.skipped
     )
+    # a stable sort: within a size, the grid's order
+    cells = sorted(cells, key=lambda c: -c[2])
     names = list(plan.models)
-    chunks: list[Chunk] = []
+    total = len(cells) * plan.boots * len(names)
+    if total == 0 or not store.path.exists():
+        codes = np.arange(total, dtype=np.int64)
+    else:
+        with store.read() as conn:
+            codes = _pending_codes(conn.connection.driver_connection, plan, cells, names, total)
+    return _chunks(plan, cells, names, codes, chunk_jobs), total, len(codes)
+
+
+def _pending_codes(raw, plan: Plan, cells: list, names: list[str], total: int) -> np.ndarray:
+    """Codes ((cell rank x boots + boot) x learners + learner rank) of the jobs of the grid
+    with no row in `results`, ascending (int64, shape (pending,)).
+
+    First the finished jobs are counted per (cell, learner), one pass over the campaign's
+    rows grouped into as many groups as the grid has cells; a finished campaign ends
+    there. Only the cells with jobs left then go through the anti-join.
+    """
+    if not raw.execute(
+        "SELECT count(*) FROM information_schema.tables WHERE table_name = 'results'"
+    ).fetchone()[0]:
+        return np.arange(total, dtype=np.int64)
+    nm, boots = len(names), plan.boots
+    # Each key is stored once (the unique key on `results`), so rows count distinct jobs.
+    counts = raw.execute(
+        "SELECT train_gait, train_frequency_hz, test_gait, test_frequency_hz, n_cycles, "
+        "model, count(*) FILTER (WHERE boot >= 0 AND boot < $boots) AS done "
+        "FROM results WHERE campaign = $name GROUP BY ALL",
+        {"boots": boots, "name": plan.name},
+    ).fetchall()
+    rank = {(tr[0], tr[1], te[0], te[1], n): i for i, (tr, te, n) in enumerate(cells)}
+    learner = {m: k for k, m in enumerate(names)}
+    done = np.zeros((len(cells), nm), dtype=np.int64)
+    for *cell, model, n_done in counts:
+        i, k = rank.get(tuple(cell)), learner.get(model)
+        if i is not None and k is not None:
+            done[i, k] = n_done
+    if done.sum() == 0:
+        return np.arange(total, dtype=np.int64)
+    open_cells = np.flatnonzero((done < boots).any(axis=1))
+    if len(open_cells) == 0:
+        return np.empty(0, dtype=np.int64)
+    frame = pd.DataFrame(
+        [(int(i), *cells[i][0], *cells[i][1], cells[i][2]) for i in open_cells],
+        columns=["rank", "tg", "tf", "dg", "df", "n"],
+    )
+    tag = next(_frame_tags)
+    raw.register(f"_suds_cells_{tag}", frame)
+    raw.register(f"_suds_learners_{tag}", pd.DataFrame({"rank": range(nm), "model": names}))
+    code = "(c.rank * $boots + {boot}) * $nm + m.rank"
+    grid = (
+        f"SELECT {code.format(boot='b.boot')} AS code FROM _suds_cells_{tag} c, "
+        f"range($boots) b(boot), _suds_learners_{tag} m"
+    )
+    finished = f"""
+        SELECT {code.format(boot="r.boot")} AS code
+        FROM results r
+        JOIN _suds_cells_{tag} c
+          ON r.train_gait = c.tg AND r.train_frequency_hz = c.tf
+         AND r.test_gait = c.dg AND r.test_frequency_hz = c.df AND r.n_cycles = c.n
+        JOIN _suds_learners_{tag} m ON r.model = m.model
+        WHERE r.campaign = $name AND r.boot >= 0 AND r.boot < $boots
+    """
+    try:
+        left = raw.execute(
+            f"SELECT g.code FROM ({grid}) g ANTI JOIN ({finished}) d ON g.code = d.code "
+            "ORDER BY g.code",
+            {"boots": boots, "nm": nm, "name": plan.name},
+        ).fetchnumpy()["code"]
+    finally:
+        raw.unregister(f"_suds_cells_{tag}")
+        raw.unregister(f"_suds_learners_{tag}")
+    return np.asarray(left, dtype=np.int64)
+
+
+_frame_tags = itertools.count()
+
+
+def _chunks(plan: Plan, cells: list, names: list[str], codes: np.ndarray, chunk_jobs: int):
+    """Chunks (lists of (draw, learner names)) of about ``chunk_jobs`` jobs from the
+    ascending job ``codes`` of `_pending_codes`, one draw's learners kept together."""
+    nm = len(names)
     current: Chunk = []
-    size = pending = 0
-    for d in sorted(draws, key=lambda d: -d.n_cycles):
-        todo = [
-            m
-            for m in names
-            if (m, d.train[0], d.train[1], d.test[0], d.test[1], d.boot, d.n_cycles) not in done
-        ]
-        if not todo:
-            continue
-        current.append((d, todo))
+    size = 0
+    draws = codes // nm
+    starts = np.flatnonzero(np.diff(draws, prepend=-1))
+    ends = np.append(starts[1:], len(codes))
+    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
+        rank, boot = divmod(int(draws[a]), plan.boots)
+        tr, te, n = cells[rank]
+        todo = [names[int(k)] for k in codes[a:b] % nm]
+        current.append((Draw(plan.name, tr, te, boot, n), todo))
         size += len(todo)
-        pending += len(todo)
         if size >= chunk_jobs:
-            chunks.append(current)
+            yield current
             current, size = [], 0
     if current:
-        chunks.append(current)
-    return chunks, len(draws) * len(names), pending
+        yield current
 
 
 def _max_cycles(plan: Plan) -> dict:
@@ -299,7 +355,7 @@ def run_campaign(
     started = time.perf_counter()
     with RunLock(store.path, name):
         store.upgrade()
-        stored, done = stored_state(store, name)
+        stored = load_stored_definition(store, name)
         merged = merge_stored(options, stored)
         prep, samples = campaign_samples(store, merged.prep, samples)
         plan, bank = plan_campaign(
@@ -310,8 +366,8 @@ def run_campaign(
             stored_design(store).added_labels | planned_conditions(store),
         )
         n_workers = _n_workers(jobs)
-        chunks, total, pending = pending_chunks(
-            plan, done, chunk_jobs or _default_chunk(plan, n_workers)
+        chunks, total, pending = pending_jobs(
+            store, plan, chunk_jobs or _default_chunk(plan, n_workers)
         )
         if total == 0:
             raise CampaignError(
