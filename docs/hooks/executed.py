@@ -26,7 +26,7 @@ def on_page_markdown(markdown, page, config, files):
         return markdown
     from typer.testing import CliRunner
 
-    from cli import app
+    from suds_exp.__main__ import app  # the checkout's cli.py (not an importable module)
 
     runner = CliRunner()
     namespace: dict = {"__name__": "__docs__"}

@@ -239,7 +239,9 @@ def cli() -> str:
     from typer.testing import CliRunner
 
     # `typer cli utils docs --name suds-exp`, run in this process
-    args = ["cli", "utils", "docs", "--name", "suds-exp"]
+    # cli.py by its path: the repository's top is not on sys.path under mkdocs
+    top = Path(__file__).resolve().parents[2]
+    args = [str(top / "cli.py"), "utils", "docs", "--name", "suds-exp"]
     done = CliRunner().invoke(typer.cli.app, args)
     if done.exit_code != 0:
         raise RuntimeError(f"typer's docs generator failed:\n{done.output}")
