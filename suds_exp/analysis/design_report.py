@@ -133,7 +133,7 @@ def skipped_html(store: Store, campaign: str) -> str:
     """The page's note of the (condition, training cycles) cells the campaign left out,
     or nothing."""
     from suds_exp.campaign.definition import skipped_cells_text
-    from suds_exp.campaign.runner import load_stored_definition
+    from suds_exp.campaign.resume import load_stored_definition
 
     # Results without a campaign row (e.g. inserted by hand) have nothing left out.
     text = skipped_cells_text(load_stored_definition(store, campaign) or {})

@@ -18,7 +18,6 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import dataclasses
-import itertools
 import json
 import logging
 import math
@@ -34,7 +33,6 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import sqlalchemy as sa
 from threadpoolctl import threadpool_limits
@@ -50,9 +48,9 @@ from suds_exp.campaign.definition import (
     normalise,
     skipped_cells_text,
 )
-from suds_exp.campaign.grid import Draw, enumerate_cells
-from suds_exp.campaign.job import RESULT_COLUMNS, Chunk, run_chunk
+from suds_exp.campaign.job import RESULT_COLUMNS, run_chunk
 from suds_exp.campaign.lock import RunLock
+from suds_exp.campaign.resume import load_stored_definition, max_cycles, pending_jobs
 from suds_exp.campaign.sampling import check_feasible
 from suds_exp.display import Summary
 from suds_exp.errors import CampaignError, ClusterLostError, StoreError
@@ -156,148 +154,6 @@ def best_learner(db: Path, campaign: str) -> tuple[str, float] | None:
     if not rows.rows or rows.rows[0][1] is None:
         return None
     return rows.rows[0][0], float(rows.rows[0][1])
-
-
-def load_stored_definition(store: Store, name: str) -> dict | None:
-    """The stored definition of campaign ``name``, or None when it does not exist."""
-    if not store.path.exists():
-        return None
-    with store.read() as conn:
-        return _stored_definition(conn, name)
-
-
-def _stored_definition(conn: sa.Connection, name: str) -> dict | None:
-    row = conn.execute(
-        sa.select(tables.campaigns.c.definition).where(tables.campaigns.c.name == name)
-    ).first()
-    return None if row is None else normalise(json.loads(row[0]))
-
-
-def pending_jobs(store: Store, plan: Plan, chunk_jobs: int) -> tuple[Iterator[Chunk], int, int]:
-    """The jobs of ``plan`` not in `results` yet, in chunks of about ``chunk_jobs`` jobs.
-
-    The set difference (every job of the grid minus the finished ones) is an anti-join in
-    DuckDB on job codes; only the codes of the jobs left come back (8 bytes a job), and
-    draws are built from them as the chunks are consumed. So a resume costs time and
-    memory in the work left, not in the work done: a finished campaign is one count.
-
-    Draws with the most training cycles come first (longest jobs first), so the last
-    tasks of a run are short and no worker idles long at the end; the order changes no
-    number, since every draw's seed comes from its key.
-
-    Returns (chunks, total jobs of the campaign, pending jobs).
-    """
-    cells = enumerate_cells(
-        plan.train_conditions, plan.test_conditions, plan.train_cycles, plan.sweep, plan.skipped
-    )
-    # a stable sort: within a size, the grid's order
-    cells = sorted(cells, key=lambda c: -c[2])
-    names = list(plan.models)
-    total = len(cells) * plan.boots * len(names)
-    if total == 0 or not store.path.exists():
-        codes = np.arange(total, dtype=np.int64)
-    else:
-        with store.read() as conn:
-            codes = _pending_codes(conn.connection.driver_connection, plan, cells, names, total)
-    return _chunks(plan, cells, names, codes, chunk_jobs), total, len(codes)
-
-
-def _pending_codes(raw, plan: Plan, cells: list, names: list[str], total: int) -> np.ndarray:
-    """Codes ((cell rank x boots + boot) x learners + learner rank) of the jobs of the grid
-    with no row in `results`, ascending (int64, shape (pending,)).
-
-    First the finished jobs are counted per (cell, learner), one pass over the campaign's
-    rows grouped into as many groups as the grid has cells; a finished campaign ends
-    there. Only the cells with jobs left then go through the anti-join.
-    """
-    if not raw.execute(
-        "SELECT count(*) FROM information_schema.tables WHERE table_name = 'results'"
-    ).fetchone()[0]:
-        return np.arange(total, dtype=np.int64)
-    nm, boots = len(names), plan.boots
-    # Each key is stored once (the unique key on `results`), so rows count distinct jobs.
-    counts = raw.execute(
-        "SELECT train_gait, train_frequency_hz, test_gait, test_frequency_hz, n_cycles, "
-        "model, count(*) FILTER (WHERE boot >= 0 AND boot < $boots) AS done "
-        "FROM results WHERE campaign = $name GROUP BY ALL",
-        {"boots": boots, "name": plan.name},
-    ).fetchall()
-    rank = {(tr[0], tr[1], te[0], te[1], n): i for i, (tr, te, n) in enumerate(cells)}
-    learner = {m: k for k, m in enumerate(names)}
-    done = np.zeros((len(cells), nm), dtype=np.int64)
-    for *cell, model, n_done in counts:
-        i, k = rank.get(tuple(cell)), learner.get(model)
-        if i is not None and k is not None:
-            done[i, k] = n_done
-    if done.sum() == 0:
-        return np.arange(total, dtype=np.int64)
-    open_cells = np.flatnonzero((done < boots).any(axis=1))
-    if len(open_cells) == 0:
-        return np.empty(0, dtype=np.int64)
-    frame = pd.DataFrame(
-        [(int(i), *cells[i][0], *cells[i][1], cells[i][2]) for i in open_cells],
-        columns=["rank", "tg", "tf", "dg", "df", "n"],
-    )
-    tag = next(_frame_tags)
-    raw.register(f"_suds_cells_{tag}", frame)
-    raw.register(f"_suds_learners_{tag}", pd.DataFrame({"rank": range(nm), "model": names}))
-    code = "(c.rank * $boots + {boot}) * $nm + m.rank"
-    grid = (
-        f"SELECT {code.format(boot='b.boot')} AS code FROM _suds_cells_{tag} c, "
-        f"range($boots) b(boot), _suds_learners_{tag} m"
-    )
-    finished = f"""
-        SELECT {code.format(boot="r.boot")} AS code
-        FROM results r
-        JOIN _suds_cells_{tag} c
-          ON r.train_gait = c.tg AND r.train_frequency_hz = c.tf
-         AND r.test_gait = c.dg AND r.test_frequency_hz = c.df AND r.n_cycles = c.n
-        JOIN _suds_learners_{tag} m ON r.model = m.model
-        WHERE r.campaign = $name AND r.boot >= 0 AND r.boot < $boots
-    """
-    try:
-        left = raw.execute(
-            f"SELECT g.code FROM ({grid}) g ANTI JOIN ({finished}) d ON g.code = d.code "
-            "ORDER BY g.code",
-            {"boots": boots, "nm": nm, "name": plan.name},
-        ).fetchnumpy()["code"]
-    finally:
-        raw.unregister(f"_suds_cells_{tag}")
-        raw.unregister(f"_suds_learners_{tag}")
-    return np.asarray(left, dtype=np.int64)
-
-
-_frame_tags = itertools.count()
-
-
-def _chunks(plan: Plan, cells: list, names: list[str], codes: np.ndarray, chunk_jobs: int):
-    """Chunks (lists of (draw, learner names)) of about ``chunk_jobs`` jobs from the
-    ascending job ``codes`` of `_pending_codes`, one draw's learners kept together."""
-    nm = len(names)
-    current: Chunk = []
-    size = 0
-    draws = codes // nm
-    starts = np.flatnonzero(np.diff(draws, prepend=-1))
-    ends = np.append(starts[1:], len(codes))
-    for a, b in zip(starts.tolist(), ends.tolist(), strict=True):
-        rank, boot = divmod(int(draws[a]), plan.boots)
-        tr, te, n = cells[rank]
-        todo = [names[int(k)] for k in codes[a:b] % nm]
-        current.append((Draw(plan.name, tr, te, boot, n), todo))
-        size += len(todo)
-        if size >= chunk_jobs:
-            yield current
-            current, size = [], 0
-    if current:
-        yield current
-
-
-def _max_cycles(plan: Plan) -> dict:
-    tests = set(plan.test_conditions)
-    return {
-        c: max([plan.train_cycles, *(plan.sweep if c in tests else [])])
-        for c in plan.train_conditions
-    }
 
 
 def run_campaign(
@@ -493,7 +349,7 @@ def plan_campaign(
         )
     # With skip_infeasible the plan already left out every cell the data cannot
     # supply; conditions without any complete cycle are refused either way.
-    needs = {} if plan.definition["options"].get("skip_infeasible") else _max_cycles(plan)
+    needs = {} if plan.definition["options"].get("skip_infeasible") else max_cycles(plan)
     # the added conditions' infeasible cells are already left out (`make_plan`)
     needs = {c: n for c, n in needs.items() if c[0] not in added and c not in added}
     check_feasible(bank, plan.train_conditions, plan.test_conditions, needs)
