@@ -34,6 +34,7 @@ import pandas as pd
 from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import main_cycles
+from suds_exp.analysis.formatting import interval_text
 from suds_exp.analysis.glm import formula_design, glm_formulas, glm_frame
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import is_paper
@@ -706,12 +707,7 @@ def findings_display(table: pd.DataFrame, digits: int = 2) -> pd.DataFrame:
     (text) and ``verdict`` (with the reason when not measurable)."""
 
     def interval(r) -> str:
-        if not np.isfinite(r["value"]):
-            return ""
-        text = f"{r['value']:.{digits}f}"
-        if np.isfinite(r["low"]) and np.isfinite(r["high"]):
-            text += f" [{r['low']:.{digits}f}, {r['high']:.{digits}f}]"
-        return text
+        return interval_text(r["value"], r["low"], r["high"], digits)
 
     return pd.DataFrame(
         {

@@ -12,6 +12,17 @@ import pandas as pd
 from suds_exp.errors import AnalysisError
 
 
+def interval_text(value: float, low: float, high: float, digits: int = 2) -> str:
+    """``value [low, high]`` to ``digits`` decimals as tables show an estimate and its
+    interval; the value alone when the interval is not finite, "" when the value is not."""
+    if not np.isfinite(value):
+        return ""
+    text = f"{value:.{digits}f}"
+    if np.isfinite(low) and np.isfinite(high):
+        text += f" [{low:.{digits}f}, {high:.{digits}f}]"
+    return text
+
+
 def _cell(value, digits: int) -> str:
     if value is None or value is pd.NA or (isinstance(value, float) and np.isnan(value)):
         return ""

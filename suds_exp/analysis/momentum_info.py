@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from suds_exp.analysis.formatting import interval_text
+
 #: Columns of the momentum-information table, one row per held-out frequency, then "all".
 MOMENTUM_COLUMNS = (
     "held_out_hz",
@@ -167,7 +169,7 @@ def momentum_display(table: pd.DataFrame) -> pd.DataFrame:
             "RMSE vx GMR (mm/s)": table["rmse_gmr"].map(lambda v: f"{v:.2f}"),
             "GMR+P (mm/s)": table["rmse_gmr_p"].map(lambda v: f"{v:.2f}"),
             "ratio [95% interval]": [
-                f"{r:.2f} [{lo:.2f}, {hi:.2f}]"
+                interval_text(r, lo, hi)
                 for r, lo, hi in zip(
                     table["ratio"], table["ratio_low"], table["ratio_high"], strict=True
                 )

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from suds_exp.analysis.formatting import interval_text
 from suds_exp.errors import AnalysisError
 
 #: What `passive_information` means, printed beside it by the demo and the report.
@@ -195,7 +196,7 @@ def passive_display(table: pd.DataFrame) -> pd.DataFrame:
             "RMSE vx, phase + r_a (mm/s)": table["rmse_ra"].map(lambda v: f"{v:.2f}"),
             "+ r_p (mm/s)": table["rmse_ra_rp"].map(lambda v: f"{v:.2f}"),
             "gain [95% interval]": [
-                f"{g:.2f} [{lo:.2f}, {hi:.2f}]"
+                interval_text(g, lo, hi)
                 for g, lo, hi in zip(
                     table["gain"], table["gain_low"], table["gain_high"], strict=True
                 )
