@@ -18,7 +18,7 @@ from rich.markup import escape
 
 from suds_exp import __version__, console
 from suds_exp.commands.messages import user_message
-from suds_exp.errors import SudsError
+from suds_exp.errors import ConfigError, SudsError
 
 if TYPE_CHECKING:
     from suds_exp.store import Store
@@ -511,6 +511,7 @@ def preprocess(
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
+    csv: Annotated[bool, typer.Option("--csv", help="With --list: the versions as CSV.")] = False,
     quiet: QuietOption = False,
 ) -> None:
     """Turn markers into samples (shape, phase, body velocity) as a stored version.
@@ -523,12 +524,15 @@ def preprocess(
       suds-exp preprocess --name smooth --param sg_window_cycles=0.15 --trials 1-2
       suds-exp preprocess --preset paper --name paper
       suds-exp preprocess --list
+      suds-exp preprocess --list --csv
     """
     from suds_exp.commands.preprocess import preprocess_command, preprocess_text, print_versions
 
+    if csv and not list_:
+        raise ConfigError("--csv goes with --list: it prints the versions as CSV")
     store = open_store(db)
     if list_:
-        print_versions(store, json_)
+        print_versions(store, json_, csv)
         return
     result = preprocess_command(
         store, name, param or [], trials_, body, preset, progress=not (quiet or json_)
@@ -664,6 +668,13 @@ def survey(
     n_boot: Annotated[int | None, old_name("--n-boot", "--boots")] = None,
     db: DbOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
+    table: Annotated[
+        str,
+        typer.Option(
+            help="With --csv: cycles (cycles to target, the default with a sweep) | timing | glm."
+        ),
+    ] = "cycles",
 ) -> None:
     """Data each learner needs and its speed: cycles to reach x1.25 of its own largest-sweep
     error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio (from a
@@ -673,13 +684,16 @@ def survey(
 
     Examples:
       suds-exp run s --models GMR,MLP --sweep 1,2 --train-cycles 2 --boots 2 \\
-        && suds-exp survey s --cycles 2 --boots 200
+        && suds-exp survey s --cycles 2 --boots 200 \\
+        && suds-exp survey s --cycles 2 --boots 200 --csv --table timing
     """
     from suds_exp.analysis.survey import survey_json, survey_tables
-    from suds_exp.commands.survey import print_survey
+    from suds_exp.commands.survey import print_survey, survey_frame
 
     tables = survey_tables(open_store(db), name, cycles, either(boots, n_boot), versus)
-    if json_:
+    if csv and not json_:
+        console.print_csv(survey_frame(tables, table))
+    elif json_:
         console.print_json(survey_json(tables))
     else:
         print_survey(tables, cycles)
@@ -690,19 +704,23 @@ def status(
     name: CampaignArgument,
     db: DbOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
 ) -> None:
     """Jobs done / total per learner, rate and time left of a campaign (also while it runs).
 
     Examples:
       suds-exp status first
       suds-exp status first --json
+      suds-exp status first --csv
     """
     from suds_exp.campaign import campaign_status
-    from suds_exp.commands.campaign import print_status
+    from suds_exp.commands.campaign import print_status, status_rows
 
     report = campaign_status(open_store(db), name)
     if json_:
         console.print_json(report)
+    elif csv:
+        console.print_csv(status_rows(report))
     else:
         print_status(report)
 
@@ -766,6 +784,14 @@ def findings(
     seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
     db: DbOption = None,
     json_: JsonOption = False,
+    csv: CsvOption = False,
+    table: Annotated[
+        str,
+        typer.Option(
+            help="With --csv: findings | passive (what the passive shape adds) | momentum "
+            "(what the velocity history adds)."
+        ),
+    ] = "findings",
 ) -> None:
     """The paper's findings F1-F10 measured on a campaign: statistic, value, 95 % bootstrap
     interval, holds / unclear / fails / not measurable (definitions: the documentation's
@@ -773,10 +799,15 @@ def findings(
 
     Examples:
       suds-exp findings first --boots 100 --json
+      suds-exp findings first --boots 100 --csv --table passive
     """
-    from suds_exp.commands.findings import show_findings
+    from suds_exp.commands.findings import findings_frame, show_findings
 
-    show_findings(open_store(db), name, n_boot=either(boots, boot), seed=seed, as_json=json_)
+    n_boot = either(boots, boot)
+    if csv and not json_:
+        console.print_csv(findings_frame(open_store(db), name, table, n_boot=n_boot, seed=seed))
+        return
+    show_findings(open_store(db), name, n_boot=n_boot, seed=seed, as_json=json_)
 
 
 @command(flags={"exclude": "--exclude-candidates", "model_effects": "--effect"})

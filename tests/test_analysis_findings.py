@@ -8,6 +8,8 @@ With noise, the intervals must cover the planted values.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 
 import numpy as np
@@ -154,3 +156,23 @@ def test_cli_findings_json_and_bad_input(store):
     assert out.exit_code == 2 and "--boots" in out.output and len(out.output.splitlines()) == 1
     out = runner.invoke(app, ["findings", "nope", "--db", str(store.path)])
     assert out.exit_code == 2 and "'nope'" in out.output
+
+
+def test_cli_findings_csv_gives_each_table_unrounded(store):
+    runner = CliRunner()
+    args = ["findings", "exact", "--db", str(store.path), "--boots", "10"]
+    out = runner.invoke(app, [*args, "--csv"])
+    assert out.exit_code == 0, out.output
+    rows = list(csv.DictReader(io.StringIO(out.stdout)))
+    assert [r["id"] for r in rows] == [f.id for f in FINDINGS]
+    doc = json.loads(runner.invoke(app, [*args, "--json"]).stdout)
+    assert float(rows[0]["value"]) == doc["statistics"][0]["value"]  # not rounded for show
+    # no samples behind these results: the passive table is its header alone
+    out = runner.invoke(app, [*args, "--csv", "--table", "passive"])
+    assert out.exit_code == 0, out.output
+    assert out.stdout.splitlines() == [
+        "frequency_hz,n_pairs,rmse_ra,rmse_ra_rp,gain,gain_low,gain_high"
+    ]
+    out = runner.invoke(app, [*args, "--csv", "--table", "nope"])
+    assert out.exit_code == 2 and "--table 'nope'" in out.output
+    assert "findings, passive, momentum" in out.output

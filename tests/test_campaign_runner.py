@@ -166,6 +166,8 @@ def test_cli_run_and_status(db, samples, monkeypatch):
     assert status["done"] == 8 and status["prep"] == "v1" and not status["running"]
     out = runner.invoke(cli.app, ["status", "c", "--db", str(db)])
     assert "8 / 8 jobs done" in out.stdout
+    out = runner.invoke(cli.app, ["status", "c", "--db", str(db), "--csv"])
+    assert out.stdout.splitlines() == ["model,done,total,failed", "phase-only,8,8,0"]
     out = runner.invoke(cli.app, ["run", "c", "--db", str(db), "--boots", "2"])
     assert out.exit_code == 2 and "boots: 1 -> 2" in out.output
     out = runner.invoke(cli.app, ["status", "nope", "--db", str(db)])

@@ -48,7 +48,13 @@ def test_a_small_command_imports_no_heavy_library(db, args):
 
 @pytest.mark.parametrize(
     "args",
-    [["trials"], ["trials", "--csv"], ["sql", "SELECT 1 AS one"], ["status", "c"]],
+    [
+        ["trials"],
+        ["trials", "--csv"],
+        ["sql", "SELECT 1 AS one"],
+        ["status", "c"],
+        ["status", "c", "--csv"],
+    ],
     ids=" ".join,
 )
 def test_trials_sql_and_status_read_without_pandas_or_sqlalchemy(db, args):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import signal
 
@@ -286,6 +288,16 @@ def test_survey_of_a_main_grid_without_sweep_gives_the_glm_and_timing(tmp_path, 
     assert "learner[kNN]" in text.output and "period_rel[" in text.output
     assert "left out: survey: no sample-efficiency results" in text.output
     assert "with --sweep" in text.output
+    table = CliRunner().invoke(
+        cli.app, ["survey", "g", "--db", str(db), "--cycles", "2", "--csv", "--table", "timing"]
+    )
+    assert table.exit_code == 0, table.output
+    timing = list(csv.DictReader(io.StringIO(table.stdout)))
+    assert {r["model"] for r in timing} == {"GMR", "kNN"}
+    # no sweep: the cycles table (the default) is refused with the reason, in one line
+    table = CliRunner().invoke(cli.app, ["survey", "g", "--db", str(db), "--cycles", "2", "--csv"])
+    assert table.exit_code == 2 and len(table.output.splitlines()) == 1
+    assert "'cycles': not measurable" in table.output and "sample-efficiency" in table.output
 
 
 def test_survey_of_a_campaign_with_neither_sweep_nor_cross_pairs_is_one_line(

@@ -3,6 +3,8 @@ parameter = a new one beside it, resumable runs, refused trials leave the DB unc
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 
 import duckdb
@@ -58,6 +60,12 @@ def test_changed_parameter_makes_a_new_version_beside_the_first(dataset):
         ("v1", 5, 4000),
         ("three", 5, 4000),
     ]
+    table = cli("preprocess", "--list", "--db", dataset, "--csv").stdout
+    rows = list(csv.DictReader(io.StringIO(table)))
+    assert [(r["name"], r["params_hash"]) for r in rows] == [
+        (v["name"], v["params_hash"]) for v in listed
+    ]
+    assert json.loads(rows[1]["params"])["k"] == 3
 
 
 def test_load_samples_gives_exactly_the_standard_columns(dataset):

@@ -81,13 +81,17 @@ def parse_model_params(items: Sequence[str], names: Sequence[str]) -> dict[str, 
     return out
 
 
-def print_status(status: dict) -> None:
-    """Print `campaign_status` as a per-learner table and one summary line."""
+def status_rows(status: dict):
+    """`campaign_status`'s per-learner counts as `Rows` (model, done, total, failed)."""
     from suds_exp.store.rows import Rows
 
-    models = status["models"]
     columns = ("model", "done", "total", "failed")
-    table = Rows(columns, [tuple(m[c] for c in columns) for m in models])
+    return Rows(columns, [tuple(m[c] for c in columns) for m in status["models"]])
+
+
+def print_status(status: dict) -> None:
+    """Print `campaign_status` as a per-learner table and one summary line."""
+    table = status_rows(status)
     console.print_rows(table, title=f"campaign {status['campaign']} (prep {status['prep']})")
     rate = status["rate_jobs_per_s"]
     line = f"{status['done']} / {status['total']} jobs done"

@@ -18,6 +18,7 @@ from suds_exp.analysis.passive import (
     passive_display,
     passive_reason,
 )
+from suds_exp.errors import ConfigError
 
 
 def show_findings(store, name: str, n_boot: int = 400, seed: int = 0, as_json=False) -> None:
@@ -36,6 +37,25 @@ def show_findings(store, name: str, n_boot: int = 400, seed: int = 0, as_json=Fa
         print_findings(table, name)
         print_passive_information(passive)
         print_momentum_information(momentum)
+
+
+FINDINGS_TABLES = ("findings", "passive", "momentum")
+
+
+def findings_frame(store, name: str, table: str = "findings", n_boot: int = 400, seed: int = 0):
+    """One of `findings`' tables as a DataFrame, unrounded: ``findings`` (F1-F10),
+    ``passive`` (what the passive shape adds) or ``momentum`` (what the velocity history
+    adds). Only the table asked for is measured."""
+    measure = {
+        "findings": findings,
+        "passive": campaign_passive_information,
+        "momentum": campaign_momentum_information,
+    }
+    if table not in measure:
+        raise ConfigError(
+            f"table {table!r}: expected one of {', '.join(FINDINGS_TABLES)}", param="table"
+        )
+    return measure[table](store, name, n_boot=n_boot, seed=seed)
 
 
 def print_findings(table: pd.DataFrame, campaign: str) -> None:

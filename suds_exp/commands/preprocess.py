@@ -36,11 +36,14 @@ def preprocess_command(
     return run_preprocess(store, name, **common)
 
 
-def print_versions(store, as_json: bool = False) -> None:
-    """The stored preprocessing versions, as a table or one JSON list."""
+def print_versions(store, as_json: bool = False, as_csv: bool = False) -> None:
+    """The stored preprocessing versions, as a table, one JSON list or CSV (every column,
+    ``params`` as its JSON text)."""
     frame = list_versions(store)
     if as_json:
         console.print_json(frame)
+    elif as_csv:
+        console.print_csv(frame.assign(params=frame.params.map(_json_text)))
     else:
         shown = frame.drop(columns=["params"]).assign(params_hash=frame.params_hash.str[:12])
         console.print_frame(shown, title="preprocessing versions")
@@ -56,8 +59,7 @@ def preprocess_text(result) -> str:
         f"in {result.seconds:.1f} s; "
         f"{explained_label(result.params)} explain {ev}"
         + (
-            f"; {result.interpolated_pose_frames} segment poses interpolated (too few "
-            "markers seen)"
+            f"; {result.interpolated_pose_frames} segment poses interpolated (too few markers seen)"
             if result.interpolated_pose_frames
             else ""
         )
@@ -88,3 +90,9 @@ def parse_param_items(items: Iterable[str]) -> dict[str, str]:
             raise ConfigError(f"params {key}: given twice", param="params")
         out[key] = value
     return out
+
+
+def _json_text(params) -> str:
+    import json
+
+    return params if isinstance(params, str) else json.dumps(params, sort_keys=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from suds_exp import console
 from suds_exp.commands.messages import user_message
+from suds_exp.errors import AnalysisError, ConfigError
 
 
 def print_survey(tables: dict, cycles: int) -> None:
@@ -20,3 +21,24 @@ def print_survey(tables: dict, cycles: int) -> None:
         console.out.print(ratio_sentence(tables["ratio"], cycles))
     for why in tables.get("missing", []):
         console.out.print(f"left out: {user_message(why)}")
+
+
+SURVEY_TABLES = ("cycles", "timing", "glm")
+
+
+def survey_frame(tables: dict, table: str = "cycles"):
+    """One of `survey_tables`' tables as a flat DataFrame (its index as columns), for CSV.
+
+    ``cycles`` needs a sweep and ``glm`` cross pairs at the main size; asking for one the
+    campaign cannot give raises the `AnalysisError` that left it out.
+    """
+    if table not in SURVEY_TABLES:
+        raise ConfigError(
+            f"table {table!r}: expected one of {', '.join(SURVEY_TABLES)}", param="table"
+        )
+    if table not in tables:
+        why = "; ".join(map(str, tables.get("missing", []))) or "not measured"
+        raise AnalysisError(f"table {table!r}: not measurable on this campaign ({why})")
+    frame = tables[table]
+    named = [n for n in frame.index.names if n is not None]
+    return frame.reset_index() if named else frame

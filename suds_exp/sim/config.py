@@ -640,6 +640,5 @@ def _check_fields(obj: Any, where: str) -> None:
         value = getattr(obj, f.name)
         if not low <= value <= high:
             raise ConfigError(
-                f"{where}.{f.name}: {value} is outside its range {low}..{high} "
-                f"{f.metadata['unit']}"
+                f"{where}.{f.name}: {value} is outside its range {low}..{high} {f.metadata['unit']}"
             )
