@@ -40,7 +40,17 @@ def _scheduler(port: int) -> subprocess.Popen:
 
 
 def _worker(address: str) -> subprocess.Popen:
-    cmd = [str(BIN / "dask"), "worker", address, "--nthreads", "1", "--host", "127.0.0.1"]
+    cmd = [
+        str(BIN / "dask"),
+        "worker",
+        address,
+        "--nthreads",
+        "1",
+        "--host",
+        "127.0.0.1",
+        "--preload",
+        "suds_exp.campaign.dask_worker",
+    ]
     cmd += ["--dashboard-address", "127.0.0.1:0", "--no-nanny"]
     return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 

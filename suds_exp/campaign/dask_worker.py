@@ -1,7 +1,13 @@
-"""Preloaded into every dask worker a campaign's local cluster starts (`preload=`).
+"""Preloaded into every dask worker a campaign's local cluster starts (`preload=`), and
+into the workers of a cluster a user starts with ``dask worker ... --preload
+suds_exp.campaign.dask_worker``.
 
-A terminal's Ctrl-C reaches the whole process group, workers included; the campaign's
-own process stops the run and closes the cluster, so a worker ignores SIGINT instead of
+A worker imports the learners (scikit-learn, SciPy, numba's cached kernels: 1-2 s) as it
+starts rather than during its first job, so a campaign's wall time and its first jobs'
+fit times do not carry every worker's imports.
+
+A terminal's Ctrl-C reaches the whole process group, workers included; the campaign's own
+process stops the run and closes the cluster, so a worker ignores SIGINT instead of
 printing its own KeyboardInterrupt traceback. Its allocator is settled before any job
 (`suds_exp.campaign.job.settle_allocator`: the nanny's fixed trim threshold costs page
 faults in every job).
@@ -20,6 +26,7 @@ def dask_setup(worker) -> None:
     from suds_exp.campaign.job import settle_allocator
 
     settle_allocator()
+    import suds_exp.models  # noqa: F401  (warm: see the module's docstring)
 
 
 # importing happens before dask_setup, as early as a worker can act
