@@ -2,7 +2,7 @@
 into the workers of a cluster a user starts with ``dask worker ... --preload
 suds_exp.campaign.dask_worker``.
 
-A worker imports the learners (scikit-learn, SciPy, numba's cached kernels: 1-2 s) as it
+A worker imports the learners (scikit-learn, SciPy: 1.5 s on a 2-core machine) as it
 starts rather than during its first job, so a campaign's wall time and its first jobs'
 fit times do not carry every worker's imports.
 
