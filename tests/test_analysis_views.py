@@ -161,3 +161,31 @@ def test_views_run_in_the_stock_duckdb_shell(tmp_path):
     ]
     assert lines[:10] == ["gait_sim,period_rel,n", *expected]
     assert lines[10:] == ["n", str(2 * 3 * 5), "n", str(5 * 2 * 3)]
+
+
+def test_load_results_in_small_batches_and_a_spilled_sort_is_duckdbs_own_frame(store, monkeypatch):
+    from suds_exp.analysis import queries
+
+    expected = load_results(store, "grid")
+    # batches of 7 rows under a low memory limit: the same frame, and the
+    # database's memory limit given back
+    monkeypatch.setattr(queries, "BATCH_ROWS", 7)
+    monkeypatch.setattr(queries, "SORT_MEMORY_BYTES", 16 * 2**20)
+    got = load_results(store, "grid")
+    pd.testing.assert_frame_equal(got, expected, check_exact=True)
+    with store.read() as conn:
+        raw = conn.connection.driver_connection
+        limit = raw.execute("SELECT current_setting('memory_limit')").fetchone()[0]
+    assert limit != "16.0 MiB"
+    plain = duckdb.connect(str(store.path), read_only=True)
+    try:
+        order = ["model", "train_gait", "train_frequency_hz", "test_gait",
+                 "test_frequency_hz", "n_cycles", "boot"]  # fmt: skip
+        direct = plain.execute(
+            "SELECT * FROM results_labelled WHERE campaign = 'grid' AND isfinite(ln_rmse_vx) "
+            f"ORDER BY {', '.join(order)}"
+        ).df()
+    finally:
+        plain.close()
+    np.testing.assert_array_equal(got["rmse_vx"], direct["rmse_vx"])
+    assert list(got["model"]) == list(direct["model"])

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import pandas as pd
 
 from suds_exp.campaign.grid import KEY_COLUMNS
@@ -74,16 +77,41 @@ def load_results(store: Store, campaign: str, columns=ANALYSIS_COLUMNS) -> pd.Da
     return frame
 
 
-#: Rows converted to pandas at a time by `load_results`.
+#: Rows fetched from DuckDB at a time by `load_results`.
 BATCH_ROWS = 500_000
+#: DuckDB's working memory while `load_results` sorts a campaign's rows: beyond it the sort
+#: spills to temporary files (beside the database), so DuckDB's share of the peak does not
+#: grow with the campaign (5M results: 1.49 GB peak instead of 1.76 GB, measured).
+SORT_MEMORY_BYTES = 512 * 2**20
 
 
 def _frame_in_batches(raw, query: str, params: list) -> pd.DataFrame:
-    """The result of ``query`` as one DataFrame, converted from Arrow a batch at a time:
-    half the peak memory of converting the whole result at once (5M results: 2.3 GB
-    instead of 4.4 GB, measured), the same frame."""
-    reader = raw.execute(query, params).to_arrow_reader(BATCH_ROWS)
-    parts = [batch.to_pandas() for batch in reader]
-    if not parts:
-        return raw.execute(query, params).df()
-    return pd.concat(parts, ignore_index=True) if len(parts) > 1 else parts[0]
+    """The result of ``query`` as one DataFrame: fetched as Arrow batches into one Arrow
+    table, which pandas takes over column by column, freeing each as it goes
+    (``self_destruct``). The same frame as converting at once, at a fraction of the peak:
+    `load_results` of 5M results peaks at 1.6 GB, against 2.7 GB for pandas batches
+    concatenated and 4.4 GB for one conversion (measured)."""
+    import pyarrow as pa
+
+    spill = _can_spill(raw)
+    if spill:
+        raw.execute(f"SET memory_limit = '{SORT_MEMORY_BYTES}B'")
+    try:
+        reader = raw.execute(query, params).to_arrow_reader(BATCH_ROWS)
+        table = pa.Table.from_batches(list(reader), schema=reader.schema)
+    finally:
+        if spill:
+            raw.execute("RESET memory_limit")
+    return table.to_pandas(split_blocks=True, self_destruct=True)
+
+
+def _can_spill(raw) -> bool:
+    """Whether DuckDB may write its temporary files: a failed attempt breaks every later
+    query of the database in this process, so the memory limit is lowered only then. The
+    project never sets DuckDB's memory limit, so RESET gives back the default (a setting
+    read back as text, '18.8 GiB', is rounded)."""
+    (folder,) = raw.execute("SELECT current_setting('temp_directory')").fetchone()
+    if not folder:
+        return False
+    folder = Path(folder)
+    return os.access(folder if folder.exists() else folder.parent, os.W_OK)
