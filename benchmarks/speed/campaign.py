@@ -3,8 +3,8 @@ finished jobs, projected paper-scale time and peak memory.
 
 Usage::
 
-    .venv/bin/python benchmarks/campaign.py [--repeats 3] [--no-projection] [--json]
-    .venv/bin/python benchmarks/campaign.py --baseline /tmp/base [--rounds 5]
+    .venv/bin/python -m benchmarks.speed.campaign [--repeats 3] [--no-projection] [--json]
+    .venv/bin/python -m benchmarks.speed.campaign --baseline /tmp/base [--rounds 5]
 
 Data: the models' synthetic swimmer (`suds_exp.testing.synthetic_swimmer.make_samples`), 5 gaits
 x 3 frequencies x 4 trials x 25 cycles captured at 100 Hz, so after decimation every
@@ -47,6 +47,9 @@ at paper scale: (fixed cost + per-job cost x 21,000 jobs) / (learners' time per 
 21,000 jobs), the per-job figures measured on the small grid. With ``--paper-boots N``
 the measured campaign is the paper's grid itself (15 x 15 pairs and the sweep on the
 synthetic data's 15 conditions) with N draws a cell (2,100 jobs for N = 1), one a process.
+
+``--quick``: a smoke run at tiny sizes (8-cycle trials, 5 training cycles, one draw, two
+learners, one repeat, a resume of 2 draws, no projection); its figures mean nothing.
 """
 
 from __future__ import annotations
@@ -56,8 +59,6 @@ import json
 import os
 import resource
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from datetime import datetime
@@ -68,60 +69,32 @@ import pandas as pd
 from joblib import parallel_config
 from threadpoolctl import threadpool_limits
 
-ROOT = Path(__file__).resolve().parents[1]
-# this tree's suds_exp, unless PYTHONPATH names the checkout to measure (--baseline runs)
-if not os.environ.get("PYTHONPATH"):
-    sys.path.insert(0, str(ROOT))
+from benchmarks._data import SMALL, fresh_store, paper_like_samples, small_grid_jobs
+from benchmarks._harness import alternate, worker
+from suds_exp.campaign import CampaignOptions, enumerate_draws, run_campaign
+from suds_exp.campaign.bank import rounded_conditions
+from suds_exp.campaign.conditions import PAPER_SWEEP
+from suds_exp.campaign.definition import resolve_models
+from suds_exp.campaign.job import RESULT_COLUMNS
+from suds_exp.models import make_model
+from suds_exp.models.registry import LEARNERS
 
-from suds_exp.campaign import CampaignOptions, SampleBank, enumerate_draws, run_campaign  # noqa: E402
-from suds_exp.campaign.bank import rounded_conditions  # noqa: E402
-from suds_exp.campaign.conditions import PAPER_SWEEP, select_conditions  # noqa: E402
-from suds_exp.campaign.definition import resolve_models  # noqa: E402
-from suds_exp.campaign.job import RESULT_COLUMNS  # noqa: E402
-from suds_exp.campaign.sampling import draw_sample  # noqa: E402
-from suds_exp.models import make_model  # noqa: E402
-from suds_exp.models.registry import LEARNERS  # noqa: E402
-from suds_exp.robot import FREQUENCIES_HZ as FREQS  # noqa: E402
-from suds_exp.robot import GAITS  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
-from suds_exp.testing.synthetic_swimmer import make_samples  # noqa: E402
-
-SMALL = "O@1/3,O@1,D+@0.5,S-@1"
+#: The sizes of a run; `_quick` shrinks them for a smoke run.
 BOOTS = 3
 CYCLES = 30
+TRIAL_CYCLES = 25
+MODELS = list(LEARNERS)
+RESUME_BOOTS = 89
 
 
-def paper_like_samples(seed: int = 0) -> pd.DataFrame:
-    """5 gaits x 3 frequencies x 4 trials x 25 cycles at 100 Hz (synthetic swimmer)."""
-    frames, tid = [], 1
-    for g in GAITS:
-        for f in FREQS:
-            s = make_samples(
-                n_cycles=25,
-                gait=g,
-                frequency_hz=f,
-                n_trials=4,
-                samples_per_cycle=int(round(100 / f)),
-                velocity="finsler",
-                substeps=2,
-                first_trial_id=tid,
-                seed=seed + tid,
-            )
-            frames.append(s)
-            tid += 4
-    return pd.concat(frames, ignore_index=True)
-
-
-def fresh_store(folder: Path, tag: str) -> Store:
-    """A new, migrated database: creating the schema is a once-per-database cost."""
-    store = Store(folder / f"{tag}_{time.perf_counter_ns()}.duckdb")
-    store.upgrade()
-    return store
+def _quick() -> None:
+    global BOOTS, CYCLES, TRIAL_CYCLES, MODELS, RESUME_BOOTS
+    BOOTS, CYCLES, TRIAL_CYCLES, MODELS, RESUME_BOOTS = 1, 5, 8, ["phase-only", "TLS"], 2
 
 
 def small_options() -> CampaignOptions:
     return CampaignOptions(
-        models=list(LEARNERS),
+        models=MODELS,
         boots=BOOTS,
         train_cycles=CYCLES,
         train_conditions=SMALL,
@@ -131,15 +104,8 @@ def small_options() -> CampaignOptions:
 
 def bare_loop(samples: pd.DataFrame) -> float:
     """Seconds of make_model + fit + predict over the small campaign's jobs."""
-    chosen = select_conditions(SMALL, rounded_conditions(samples), "--x")
-    bank = SampleBank.build(samples, chosen)
-    models = resolve_models(list(LEARNERS), "measured")
-    jobs = []
-    for d in enumerate_draws("bench", chosen, chosen, BOOTS, CYCLES, []):
-        s = draw_sample(bank, d, CYCLES)
-        train = bank.frame([bank.rows(*r) for r in s.train])
-        test = bank.frame([bank.rows(*s.test)])
-        jobs.append((train, test))
+    models = resolve_models(MODELS, "measured")
+    jobs = small_grid_jobs(samples, BOOTS, CYCLES)
     t0 = time.perf_counter()
     with threadpool_limits(limits=1):
         for train, test in jobs:
@@ -170,7 +136,7 @@ def campaign_seconds(
         cpu["parent"] = _cpu() - c0
         after = worker_usage() if jobs > 1 else {}
         cpu["workers"] = [after[p][0] - before.get(p, (0.0, 0))[0] for p in after]
-    expected = s.total_jobs if options else 16 * BOOTS * len(LEARNERS)
+    expected = s.total_jobs if options else 16 * BOOTS * len(MODELS)
     assert s.done_now == s.total_jobs == expected and s.failed_now == 0, s
     learners = store.query_df("SELECT sum(fit_seconds + predict_seconds) AS s FROM results").s[0]
     if cpu is not None:
@@ -190,7 +156,7 @@ _SAMPLES: pd.DataFrame | None = None
 def _bare_in_process(_) -> float:
     global _SAMPLES
     if _SAMPLES is None:
-        _SAMPLES = paper_like_samples()
+        _SAMPLES = paper_like_samples(n_cycles=TRIAL_CYCLES)
     return bare_loop(_SAMPLES)
 
 
@@ -210,7 +176,7 @@ def machine_capacity() -> float:
 def overhead_and_speedup(samples, folder, repeats):
     campaign_seconds(samples, folder, 2)  # spawn and warm the loky workers
     bare, one, two, inside, capacity, cpu_speedup, fixed, per_job = ([] for _ in range(8))
-    n = 16 * BOOTS * len(LEARNERS)
+    n = 16 * BOOTS * len(MODELS)
 
     for _ in range(repeats):
         bare.append(bare_loop(samples))
@@ -312,23 +278,14 @@ def overhead_figures(r: dict) -> dict:
 
 def compare_with_baseline(baseline: str, rounds: int, per_process: int, paper_boots: int) -> None:
     """Print the overhead of ``baseline`` (a folder or a commit) and of this tree."""
-    from learner_speed import alternate
 
-    def run(path: Path) -> list[dict]:
-        env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
-        cmd = [sys.executable, __file__, "--overhead-worker", str(per_process)]
-        cmd += ["--paper-boots", str(paper_boots)]
-        res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
-        return json.loads(res.stdout.splitlines()[-1])
+    def run(tree: Path) -> list[dict]:
+        args = [str(per_process), "--paper-boots", str(paper_boots)]
+        args += ["--quick"] if CYCLES != 30 else []
+        return worker(tree, __spec__.name, *args, OMP_NUM_THREADS="1")
 
     load = os.getloadavg()
-    if Path(baseline).is_dir():
-        base, now = [], []
-        for _ in range(rounds):
-            base.append(run(Path(baseline)))
-            now.append(run(ROOT))
-    else:
-        base, now = alternate(baseline, rounds, run)
+    base, now = alternate(baseline, rounds, run)
     fb = [overhead_figures(r) for rs in base for r in rs]
     fn = [overhead_figures(r) for rs in now for r in rs]
     grid = (
@@ -351,11 +308,11 @@ def compare_with_baseline(baseline: str, rounds: int, per_process: int, paper_bo
 
 def resume_seconds(samples, folder, repeats):
     store = fresh_store(folder, "resume")
-    options = CampaignOptions(models=list(LEARNERS), boots=89, train_cycles=30)
+    options = CampaignOptions(models=MODELS, boots=RESUME_BOOTS, train_cycles=CYCLES)
     have = rounded_conditions(samples)
-    draws = enumerate_draws("big", have, have, 89, 30, [])
-    n = len(draws) * len(LEARNERS)
-    keys = [(d, m) for d in draws for m in LEARNERS]
+    draws = enumerate_draws("big", have, have, RESUME_BOOTS, CYCLES, [])
+    n = len(draws) * len(MODELS)
+    keys = [(d, m) for d in draws for m in MODELS]
     rows = pd.DataFrame(
         {
             "campaign": "big",
@@ -365,11 +322,11 @@ def resume_seconds(samples, folder, repeats):
             "test_gait": [d.test[0] for d, _ in keys],
             "test_frequency_hz": [d.test[1] for d, _ in keys],
             "boot": [d.boot for d, _ in keys],
-            "n_cycles": 30,
+            "n_cycles": CYCLES,
             "train_trials": "[1]",
-            "train_ranges": "[[1, 1, 30]]",
+            "train_ranges": f"[[1, 1, {CYCLES}]]",
             "test_trial": 2,
-            "test_range": "[1, 30]",
+            "test_range": f"[1, {CYCLES}]",
             "rmse_vx": np.random.default_rng(0).uniform(1, 10, n),
             "rmse_vy": 1.0,
             "rmse_wz": 0.1,
@@ -458,22 +415,26 @@ def main(argv=None):
         default=0,
         help="with --baseline: measure on the paper's grid with this many draws a cell",
     )
-    ap.add_argument("--overhead-worker", type=int, default=0, help=argparse.SUPPRESS)
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    ap.add_argument("--worker", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.quick:
+        _quick()
+        args.repeats, args.no_projection = 1, True
     if args.baseline:
         per_process = 1 if args.paper_boots else 2
         compare_with_baseline(args.baseline, args.rounds, per_process, args.paper_boots)
         return
     folder = Path(tempfile.mkdtemp(prefix="suds_bench_campaign_"))
-    if args.overhead_worker:
+    if args.worker:
         import suds_exp
 
-        samples = paper_like_samples()
-        rounds = overhead_rounds(samples, folder, args.overhead_worker, args.paper_boots)
+        samples = paper_like_samples(n_cycles=TRIAL_CYCLES)
+        rounds = overhead_rounds(samples, folder, args.worker, args.paper_boots)
         print(json.dumps([r | {"suds_exp": suds_exp.__file__} for r in rounds]))
         return
     t0 = time.perf_counter()
-    samples = paper_like_samples()
+    samples = paper_like_samples(n_cycles=TRIAL_CYCLES)
     out = {"samples_rows": len(samples), "samples_seconds": time.perf_counter() - t0}
     out["load_average_before"] = os.getloadavg()
     out["overhead"] = overhead_and_speedup(samples, folder, args.repeats)

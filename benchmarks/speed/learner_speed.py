@@ -2,8 +2,8 @@
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/learner_speed.py [--baseline c2aa7be] [--rounds 5]
-        [--repeats 5] [--cycles 30] [--models phase-only,TLS,...,MLP,GBT]
+    .venv/bin/python -m benchmarks.speed.learner_speed [--baseline c2aa7be] [--rounds 5]
+        [--repeats 5] [--cycles 30] [--models phase-only,TLS,...,MLP,GBT] [--quick]
 
 ``--models``: the learners to time (default: the paper's five and the rollout mode);
 with the paper's five and more (e.g. the survey's learners) it also prints all learners'
@@ -13,13 +13,14 @@ The baseline's `suds_exp` is exported from git (`git archive`) into a temporary 
 rounds alternate a worker process on the baseline and one on the working tree (A B A B
 ...), so a change in the machine's load hits both. Each worker fits and predicts every
 learner `--repeats` times, single-threaded BLAS (the campaign runs one job a core), on the
-campaign benchmark's synthetic data (`benchmarks/campaign.py`, 5 gaits x 3 frequencies x
-4 trials, 100 samples a cycle): the first bootstrap draws of its small grid at
+campaign benchmarks' synthetic data (`benchmarks._data.paper_like_samples`, 5 gaits x 3
+frequencies x 4 trials, 100 samples a cycle): the first bootstrap draws of its small grid at
 `--cycles` training cycles, predicting a different trial of the test condition. It
 reports the median CPU seconds of one job (fit + predict) per learner; the table gives
 the medians over rounds and the ratio baseline / now per round (its median, min, max).
 Each worker also hashes every prediction, so the table says whether the working tree's
-predictions are bit-identical to the baseline's.
+predictions are bit-identical to the baseline's. ``--quick``: baseline HEAD, one round, one
+repeat of one draw at 5 cycles on 8-cycle trials, two learners (a smoke run, no figure).
 """
 
 from __future__ import annotations
@@ -27,17 +28,13 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
-import subprocess
 import sys
-import tarfile
-import tempfile
 import time
-from io import BytesIO
-from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
+from benchmarks import _data
+from benchmarks._harness import alternate, same, speedup, worker
+
 PAPER_FIVE = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
 CASES = [
     ("phase-only", {}),
@@ -61,32 +58,17 @@ def cases(models: str | None) -> list[tuple[str, dict]]:
     return [(n, {} if n in PAPER_FIVE else {"random_state": 0}) for n in models.split(",")]
 
 
-def worker(cycles: int, repeats: int, n_jobs: int, models: str | None = None) -> dict:
+def measure(
+    cycles: int, repeats: int, n_jobs: int, models: str | None = None, trial_cycles: int = 25
+) -> dict:
     """{learner: [median CPU s per job, sha256 of its predictions]} in this process."""
     from threadpoolctl import threadpool_limits
 
-    import suds_exp  # first: campaign.py puts the working tree on sys.path
-
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import campaign as cb
-
-    from suds_exp.campaign import SampleBank, enumerate_draws
-    from suds_exp.campaign.bank import rounded_conditions
-    from suds_exp.campaign.conditions import select_conditions
-    from suds_exp.campaign.sampling import draw_sample
+    import suds_exp
     from suds_exp.models import make_model
 
-    samples = cb.paper_like_samples()
-    chosen = select_conditions(cb.SMALL, rounded_conditions(samples), "--x")
-    bank = SampleBank.build(samples, chosen)
-    jobs = []
-    for d in enumerate_draws("bench", chosen, chosen, 1, cycles, []):
-        s = draw_sample(bank, d, cycles)
-        jobs.append(
-            (bank.frame([bank.rows(*r) for r in s.train]), bank.frame([bank.rows(*s.test)]))
-        )
-        if len(jobs) == n_jobs:
-            break
+    samples = _data.paper_like_samples(n_cycles=trial_cycles)
+    jobs = _data.small_grid_jobs(samples, boots=1, cycles=cycles, limit=n_jobs)
     out = {"suds_exp": [0.0, suds_exp.__file__]}
     with threadpool_limits(limits=1):
         for name, params in cases(models):
@@ -102,33 +84,11 @@ def worker(cycles: int, repeats: int, n_jobs: int, models: str | None = None) ->
     return out
 
 
-def alternate(commit: str, rounds: int, run) -> tuple[list, list]:
-    """``run(path)`` on an export of ``commit`` and on the working tree, in turn, ``rounds``
-    times (so load changes hit both sides); returns the baseline's and the tree's results."""
-    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
-        _export(commit, Path(tmp))
-        base, now = [], []
-        for _ in range(rounds):
-            base.append(run(Path(tmp)))
-            now.append(run(ROOT))
-    return base, now
-
-
-def _export(commit: str, folder: Path) -> None:
-    data = subprocess.run(
-        ["git", "archive", commit, "suds_exp", "cli.py"], cwd=ROOT, check=True, capture_output=True
-    ).stdout
-    with tarfile.open(fileobj=BytesIO(data)) as tar:
-        tar.extractall(folder, filter="data")
-
-
-def _run(path: Path, a) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
-    cmd = [sys.executable, __file__, "--worker", "--cycles", str(a.cycles)]
-    cmd += ["--repeats", str(a.repeats), "--jobs", str(a.jobs)]
-    cmd += ["--models", a.models] if a.models else []
-    res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
-    return json.loads(res.stdout.splitlines()[-1])
+def _run(tree, a) -> dict:
+    args = ["--cycles", str(a.cycles), "--repeats", str(a.repeats), "--jobs", str(a.jobs)]
+    args += ["--trial-cycles", str(a.trial_cycles)]
+    args += ["--models", a.models] if a.models else []
+    return worker(tree, __spec__.name, *args, OMP_NUM_THREADS="1")
 
 
 def main(argv=None) -> int:
@@ -139,10 +99,15 @@ def main(argv=None) -> int:
     ap.add_argument("--cycles", type=int, default=30)
     ap.add_argument("--jobs", type=int, default=4, help="bootstrap draws per learner")
     ap.add_argument("--models", default=None, help="learners, comma-separated (default: CASES)")
+    ap.add_argument("--trial-cycles", type=int, default=25, help="cycles of each trial")
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.quick:
+        a.baseline, a.rounds, a.repeats, a.cycles, a.jobs = "HEAD", 1, 1, 5, 1
+        a.trial_cycles, a.models = 8, "phase-only,TLS"
     if a.worker:
-        print(json.dumps(worker(a.cycles, a.repeats, a.jobs, a.models)))
+        print(json.dumps(measure(a.cycles, a.repeats, a.jobs, a.models, a.trial_cycles)))
         return 0
     base, now = alternate(a.baseline, a.rounds, lambda path: _run(path, a))
     print(
@@ -156,11 +121,10 @@ def main(argv=None) -> int:
     for key in base[0]:
         b = [r[key][0] for r in base]
         n = [r[key][0] for r in now]
-        ratios = sorted(x / y for x, y in zip(b, n, strict=True))
-        same = all(r[key][1] == base[0][key][1] for r in base + now)
+        identical = same(r[key][1] for r in base + now)
         print(
-            f"| {key} | {median(b):.4f} | {median(n):.4f} | {median(ratios):.2f}x "
-            f"[{ratios[0]:.2f}, {ratios[-1]:.2f}] | {'bit-identical' if same else 'DIFFER'} |"
+            f"| {key} | {median(b):.4f} | {median(n):.4f} | {speedup(b, n)} "
+            f"| {'bit-identical' if identical else 'DIFFER'} |"
         )
     if set(PAPER_FIVE) <= set(base[0]) and len(base[0]) > len(PAPER_FIVE):
         # the survey's cost against the paper's five: per round, all learners' CPU over
