@@ -2,7 +2,7 @@
 process and the median/ratio table.
 
 A comparison runs the same worker on two trees: an export of the baseline commit (`git
-archive` of `suds_exp/` and `cli.py` into a temporary folder) and the working tree. Rounds
+archive` of `suds_exp/`, `cli.py` and `pyproject.toml` into a temporary folder) and the working tree. Rounds
 alternate (A B A B ...), so a change in the machine's load hits both sides. A worker is a
 ``python -m benchmarks.<...> --worker ...`` process whose `suds_exp` is its tree's: the
 tree comes first on its path, then the working tree's root for the `benchmarks` package
@@ -25,8 +25,9 @@ from statistics import median
 
 #: The working tree's root (the repository checkout these benchmarks belong to).
 ROOT = Path(__file__).resolve().parents[1]
-#: What an export of a baseline holds: the package and the command layer.
-EXPORTED = ("suds_exp", "cli.py")
+#: What an export of a baseline holds: the package, the command layer, and pyproject.toml,
+#: by which `python -m suds_exp` knows a checkout (and loads its cli.py).
+EXPORTED = ("suds_exp", "cli.py", "pyproject.toml")
 
 
 def export(commit: str, folder: Path, paths: Sequence[str] = EXPORTED) -> None:

@@ -2,8 +2,8 @@
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/campaign_cost.py [--baseline 3454561] [--rounds 3]
-        [--boots 1] [--sweep 1,4,16,30,48] [--writes N]
+    .venv/bin/python -m benchmarks.speed.campaign_cost [--baseline 3454561] [--rounds 3]
+        [--boots 1] [--sweep 1,4,16,30,48] [--writes N] [--quick]
 
 The baseline's `suds_exp` is exported from git (`git archive`) into a temporary folder;
 rounds alternate a worker process on the baseline and one on the working tree (A B A B
@@ -11,10 +11,10 @@ rounds alternate a worker process on the baseline and one on the working tree (A
 this was written on is shared, and CPU seconds of a single-threaded process (BLAS on
 one thread, as a campaign's workers run) do not depend much on how many others run.
 
-Each worker, on the campaign benchmark's synthetic data (`benchmarks/campaign.py`: 5
+Each worker, on the campaign benchmarks' synthetic data (`benchmarks._data`: 5
 gaits x 3 frequencies x 4 trials, 100 samples a cycle), runs in-process (``jobs=1``):
 
-1. the small grid of `benchmarks/campaign.py` (O@1/3, O@1, D+@0.5, S-@1, train x test,
+1. the small grid of `benchmarks._data` (O@1/3, O@1, D+@0.5, S-@1, train x test,
    the paper's five learners, ``--boots`` draws, 30 training cycles and the ``--sweep``
    sizes on the same-condition pairs) as a campaign on a new database: process CPU s;
 2. the same call again with every job done: the fixed cost a run pays once (lock,
@@ -30,6 +30,9 @@ Framework CPU per job = (1 - 2 - 3) / jobs; learners' CPU per job = 3 / jobs. Th
 table of each run is reduced to a sha256 of its rows (key columns and the three RMSEs,
 sorted; timing columns left out): "identical" means every worker on both sides wrote the
 same table bit for bit. Medians over rounds.
+
+``--quick``: a smoke run (baseline HEAD, one round, 8-cycle trials, 5 training cycles, no
+sweep, two learners); its figures mean nothing.
 """
 
 from __future__ import annotations
@@ -37,49 +40,42 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+from benchmarks import _data
+from benchmarks._harness import alternate, same, worker
 
-from learner_speed import alternate  # noqa: E402  (baseline export and working tree in turn)
+#: A smoke run's sizes: trial cycles, training cycles, learners.
+QUICK = (8, 5, ["phase-only", "TLS"])
 
 
-def worker(boots: int, sweep: list[int]) -> dict:
+def measure(boots: int, sweep: list[int], quick: bool = False) -> dict:
     """CPU seconds of the three steps and the results table's digest, in this process."""
     from threadpoolctl import threadpool_limits
 
-    import suds_exp  # first: campaign.py puts the working tree on sys.path
-
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import campaign as cb
-
-    from suds_exp.campaign import CampaignOptions, SampleBank, enumerate_draws, run_campaign
-    from suds_exp.campaign.bank import rounded_conditions
-    from suds_exp.campaign.conditions import select_conditions
+    import suds_exp
+    from suds_exp.campaign import CampaignOptions, run_campaign
     from suds_exp.campaign.definition import resolve_models
-    from suds_exp.campaign.sampling import draw_sample
     from suds_exp.models import make_model
     from suds_exp.models.registry import LEARNERS
 
-    samples = cb.paper_like_samples()
+    trial_cycles, cycles, learners = QUICK if quick else (25, _data.CYCLES, list(LEARNERS))
+    samples = _data.paper_like_samples(n_cycles=trial_cycles)
     options = CampaignOptions(
-        models=list(LEARNERS),
+        models=learners,
         boots=boots,
-        train_cycles=cb.CYCLES,
-        train_conditions=cb.SMALL,
-        test_conditions=cb.SMALL,
+        train_cycles=cycles,
+        train_conditions=_data.SMALL,
+        test_conditions=_data.SMALL,
         sweep=sweep,
     )
     out = {"suds_exp": suds_exp.__file__}
     with tempfile.TemporaryDirectory() as folder:
-        store = cb.fresh_store(Path(folder), "cost")
+        store = _data.fresh_store(Path(folder), "cost")
         c0 = time.process_time()
         s = run_campaign(store, "bench", options, samples=samples, jobs=1, progress=False)
         out["campaign_cpu"] = time.process_time() - c0
@@ -97,14 +93,8 @@ def worker(boots: int, sweep: list[int]) -> dict:
             rows.to_csv(index=False, float_format="%.17g").encode()
         ).hexdigest()[:16]
         out["rmse_vx_sum"] = float(rows["rmse_vx"].sum())
-    chosen = select_conditions(cb.SMALL, rounded_conditions(samples), "--x")
-    bank = SampleBank.build(samples, chosen)
-    models = resolve_models(list(LEARNERS), "measured")
-    jobs = []
-    for d in enumerate_draws("bench", chosen, chosen, boots, cb.CYCLES, sweep):
-        smp = draw_sample(bank, d, cb.CYCLES)
-        train = bank.frame([bank.rows(*r) for r in smp.train])
-        jobs.append((train, bank.frame([bank.rows(*smp.test)])))
+    models = resolve_models(learners, "measured")
+    jobs = _data.small_grid_jobs(samples, boots, cycles, sweep)
     c0 = time.process_time()
     with threadpool_limits(limits=1):
         for train, test in jobs:
@@ -117,16 +107,23 @@ def worker(boots: int, sweep: list[int]) -> dict:
 
 def write_cost(n_writes: int) -> str:
     """Median CPU and wall seconds of one 500-row batch write, as the runner makes it."""
-    import campaign as cb
     import pandas as pd
 
-    from suds_exp.campaign import run_campaign
+    from suds_exp.campaign import CampaignOptions, run_campaign
     from suds_exp.campaign.runner import BATCH_ROWS
+    from suds_exp.models.registry import LEARNERS
 
     with tempfile.TemporaryDirectory() as folder:
-        store = cb.fresh_store(Path(folder), "writes")
-        samples = cb.paper_like_samples()
-        run_campaign(store, "bench", cb.small_options(), samples=samples, progress=False)
+        store = _data.fresh_store(Path(folder), "writes")
+        samples = _data.paper_like_samples()
+        small = CampaignOptions(
+            models=list(LEARNERS),
+            boots=_data.BOOTS,
+            train_cycles=_data.CYCLES,
+            train_conditions=_data.SMALL,
+            test_conditions=_data.SMALL,
+        )
+        run_campaign(store, "bench", small, samples=samples, progress=False)
         rows = store.query_df("SELECT * FROM results")
         copies = -(-BATCH_ROWS // len(rows))
         batch = pd.concat([rows.assign(boot=rows.boot + 100 * i) for i in range(copies)])
@@ -146,11 +143,9 @@ def write_cost(n_writes: int) -> str:
     )
 
 
-def _run(path: Path, a) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
-    cmd = [sys.executable, __file__, "--worker", "--boots", str(a.boots), "--sweep", a.sweep]
-    res = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
-    return json.loads(res.stdout.splitlines()[-1])
+def _run(tree: Path, a) -> dict:
+    args = ["--boots", str(a.boots), "--sweep", a.sweep] + (["--quick"] if a.quick else [])
+    return worker(tree, __spec__.name, *args, OMP_NUM_THREADS="1")
 
 
 def _figures(r: dict) -> dict:
@@ -170,14 +165,17 @@ def main(argv=None) -> int:
     ap.add_argument("--boots", type=int, default=1)
     ap.add_argument("--sweep", default="1,4,16,30,48")
     ap.add_argument("--writes", type=int, default=0, help="time N batch writes instead")
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.quick and not a.worker:
+        a.baseline, a.rounds, a.sweep = "HEAD", 1, ""
     if a.writes:
         print(write_cost(a.writes))
         return 0
     sweep = [int(x) for x in a.sweep.split(",") if x]
     if a.worker:
-        print(json.dumps(worker(a.boots, sweep)))
+        print(json.dumps(measure(a.boots, sweep, a.quick)))
         return 0
     base, now = alternate(a.baseline, a.rounds, lambda path: _run(path, a))
     n = base[0]["jobs"]
@@ -196,10 +194,10 @@ def main(argv=None) -> int:
         print(f"| {key} | {median(b):.2f} | {median(m):.2f} | {spread} |")
     share = [f["framework ms/job"] / f["learners ms/job"] for f in fn]
     print(f"framework / learners, now: {100 * median(share):.1f} % (median of the rounds)")
-    digests = {r["results_sha"] for r in base + now}
+    digests = [r["results_sha"] for r in base + now]
     print(
         "results table: "
-        + ("identical" if len(digests) == 1 else f"DIFFER ({sorted(digests)})")
+        + ("identical" if same(digests) else f"DIFFER ({sorted(set(digests))})")
         + f" in all {len(base) + len(now)} runs (sha256 of the sorted rows, timing left out; "
         f"sum of rmse_vx {now[0]['rmse_vx_sum']!r})"
     )

@@ -2,15 +2,16 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/em_speed.py [--baseline c2aa7be] [--rounds 7]
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.speed.em_speed [--baseline c2aa7be] [--rounds 7]
 
 The baseline's `suds_exp/models/mixture.py` is read with `git show` and loaded beside the
 current one. The inputs are the standardised training matrices GMR and GMR+SUDS hand to
-EM on the first 4 bootstrap draws of the campaign benchmark's data
-(`benchmarks/campaign.py`, 30 cycles, 3000 samples; D = 7 and 11), K = 16, the learners'
+EM on the first 4 bootstrap draws of the campaign benchmarks' data
+(`benchmarks._data`, 30 cycles, 3000 samples; D = 7 and 11), K = 16, the learners'
 defaults. Old and new alternate on each matrix (`--rounds` times), single-threaded BLAS;
 the fitted mixtures must be equal (np.array_equal). Prints per D the median CPU ms of
-each and the median of the paired ratios old / new.
+each and the median of the paired ratios old / new. ``--quick``: baseline HEAD, one
+round on one draw of 5 cycles, K = 4 (a smoke run, no figure).
 """
 
 from __future__ import annotations
@@ -26,18 +27,11 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-import campaign as cb  # noqa: E402
-
-import suds_exp.models.gmr as gmr_module  # noqa: E402
-from suds_exp.campaign import SampleBank, enumerate_draws  # noqa: E402
-from suds_exp.campaign.bank import rounded_conditions  # noqa: E402
-from suds_exp.campaign.conditions import select_conditions  # noqa: E402
-from suds_exp.campaign.sampling import draw_sample  # noqa: E402
-from suds_exp.models import make_model  # noqa: E402
-from suds_exp.models import mixture as new  # noqa: E402
+import suds_exp.models.gmr as gmr_module
+from benchmarks import _data
+from benchmarks._harness import ROOT
+from suds_exp.models import make_model
+from suds_exp.models import mixture as new
 
 
 def _old_mixture(commit: str, folder: Path):
@@ -57,11 +51,9 @@ def _old_mixture(commit: str, folder: Path):
     return mod
 
 
-def em_inputs(n_draws: int = 4) -> list[np.ndarray]:
+def em_inputs(n_draws: int = 4, cycles: int = 30, trial_cycles: int = 25) -> list[np.ndarray]:
     """The matrices GMR and GMR+SUDS pass to fit_mixture on the first draws."""
-    samples = cb.paper_like_samples()
-    chosen = select_conditions(cb.SMALL, rounded_conditions(samples), "--x")
-    bank = SampleBank.build(samples, chosen)
+    samples = _data.paper_like_samples(n_cycles=trial_cycles)
     seen = []
     real = gmr_module.fit_mixture
 
@@ -71,11 +63,7 @@ def em_inputs(n_draws: int = 4) -> list[np.ndarray]:
 
     gmr_module.fit_mixture = grab
     try:
-        for i, d in enumerate(enumerate_draws("bench", chosen, chosen, 1, 30, [])):
-            if i == n_draws:
-                break
-            s = draw_sample(bank, d, 30)
-            train = bank.frame([bank.rows(*r) for r in s.train])
+        for train, _ in _data.small_grid_jobs(samples, 1, cycles, limit=n_draws):
             make_model("GMR").fit(train)
             make_model("GMR+SUDS").fit(train)
     finally:
@@ -87,11 +75,15 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="c2aa7be")
     ap.add_argument("--rounds", type=int, default=7)
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     a = ap.parse_args(argv)
+    k, sizes = 16, {}
+    if a.quick:
+        a.baseline, a.rounds, k, sizes = "HEAD", 1, 4, {"n_draws": 1, "cycles": 5, "trial_cycles": 8}
     with tempfile.TemporaryDirectory() as tmp:
         old = _old_mixture(a.baseline, Path(tmp))
         pairs: dict[int, list] = {}
-        inputs = em_inputs()
+        inputs = em_inputs(**sizes)
         with threadpool_limits(limits=1):
             for _ in range(a.rounds):
                 for X in inputs:
@@ -99,8 +91,8 @@ def main(argv=None) -> int:
                     fits, cpu = [], []
                     for mod in (old, new):
                         c0 = time.process_time()
-                        rng = np.random.default_rng([0, 16])
-                        fits.append(mod.fit_mixture(X, 16, w, 60, 1e-3, 1e-3, rng))
+                        rng = np.random.default_rng([0, k])
+                        fits.append(mod.fit_mixture(X, k, w, 60, 1e-3, 1e-3, rng))
                         cpu.append(time.process_time() - c0)
                     same = all(
                         np.array_equal(getattr(fits[0], f), getattr(fits[1], f))

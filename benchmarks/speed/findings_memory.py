@@ -2,14 +2,15 @@
 
 Usage::
 
-    .venv/bin/python benchmarks/findings_memory.py --baseline bc6c20e --draws 100 --boot 400
+    .venv/bin/python -m benchmarks.speed.findings_memory --baseline bc6c20e --draws 100 --boot 400
 
 Each side runs in its own process (the baseline from a `git archive` of ``--baseline``,
 alternating with the working tree, ``--rounds`` times): synthetic labelled results
 (`suds_exp.testing.synthetic_results`, ``--draws`` draws per pair at 3, 10 and 30
 training cycles: 3,375 rows per draw) through `findings_table` with ``--boot``
 replicates. It prints each side's median peak resident memory (MB), median seconds, and
-a digest of the table, which must agree.
+a digest of the table, which must agree. ``--quick``: baseline HEAD, one round, 2 draws
+and 20 replicates (a smoke run, no figure).
 """
 
 from __future__ import annotations
@@ -17,18 +18,15 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import resource
-import subprocess
-import sys
 import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
+from benchmarks._harness import alternate, same, worker
 
 
-def worker(draws: int, boot: int) -> dict:
+def measure(draws: int, boot: int) -> dict:
     from suds_exp.analysis.findings import findings_table
     from suds_exp.testing.synthetic_results import synthetic_results
 
@@ -54,22 +52,18 @@ def main(argv=None) -> int:
     ap.add_argument("--draws", type=int, default=100, help="draws per pair")
     ap.add_argument("--boot", type=int, default=400, help="bootstrap replicates")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.quick:
+        a.baseline, a.rounds, a.draws, a.boot = "HEAD", 1, 2, 20
     if a.worker:
-        print(json.dumps(worker(a.draws, a.boot)))
+        print(json.dumps(measure(a.draws, a.boot)))
         return 0
 
-    # only the parent reads the working tree: each worker imports its side's suds_exp
-    sys.path.insert(0, str(ROOT))
-    from benchmarks.learner_speed import alternate
-
-    def run(path: Path) -> dict:
-        env = dict(os.environ, PYTHONPATH=str(path), OMP_NUM_THREADS="1")
-        cmd = [sys.executable, "-P", __file__, "--worker", "--draws", str(a.draws)]
-        cmd += ["--boot", str(a.boot)]
-        out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True, cwd=path)
-        return json.loads(out.stdout.splitlines()[-1])
+    def run(tree: Path) -> dict:
+        args = ["--draws", str(a.draws), "--boot", str(a.boot)]
+        return worker(tree, __spec__.name, *args, OMP_NUM_THREADS="1")
 
     base, now = alternate(a.baseline, a.rounds, run)
     print(f"{now[0]['rows']:,} results, {a.boot} replicates, {a.rounds} rounds (medians)")
@@ -80,9 +74,10 @@ def main(argv=None) -> int:
             f"({median(r['data_mb'] for r in runs):5.0f})        "
             f"{median(r['seconds'] for r in runs):7.1f}  {runs[0]['digest']}"
         )
-    same = {r["digest"] for r in base + now}
-    print("same table on both sides" if len(same) == 1 else f"TABLES DIFFER: {sorted(same)}")
-    return 0 if len(same) == 1 else 1
+    digests = [r["digest"] for r in base + now]
+    identical = same(digests)
+    print("same table on both sides" if identical else f"TABLES DIFFER: {sorted(set(digests))}")
+    return 0 if identical else 1
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/store_open.py [--baseline b16e0d5] [--rounds 3] [--repeats 15]
+    .venv/bin/python -m benchmarks.speed.store_open [--baseline b16e0d5] [--rounds 3] [--repeats 15]
 
 Every command opens the DuckDB file for each block it reads or writes; a new database
 also gets its migrations. Each worker process (alternating: the baseline's `suds_exp`,
@@ -16,7 +16,8 @@ exported with `git archive`, then the working tree's; both read the working tree
 
 and prints their medians in milliseconds, with a digest of the schema a new database gets
 (every table's columns and types, and the recorded migrations without their time), so the
-table says whether both sides create the same database.
+table says whether both sides create the same database. ``--quick``: baseline HEAD, one
+round of two repeats (a smoke run, no figure).
 """
 
 from __future__ import annotations
@@ -25,17 +26,13 @@ import argparse
 import hashlib
 import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-from learner_speed import alternate  # noqa: E402  (baseline export, alternating rounds)
+from benchmarks._harness import ROOT, alternate, same, worker
 
 CASES = ("new database", "first write", "read")
 
@@ -52,7 +49,7 @@ def _schema_digest(path: Path) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def worker(repeats: int) -> dict:
+def measure(repeats: int) -> dict:
     """Median milliseconds of each of `CASES` in this process, and the schema digest."""
     from suds_exp.store import Store
 
@@ -80,13 +77,9 @@ def worker(repeats: int) -> dict:
     }
 
 
-def _run(path: Path, repeats: int) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(path), SUDS_MIGRATIONS=str(ROOT / "migrations"))
-    res = subprocess.run(
-        [sys.executable, __file__, "--worker", "--repeats", str(repeats)],
-        env=env, check=True, capture_output=True, text=True, cwd=path,
-    )  # fmt: skip
-    return json.loads(res.stdout.splitlines()[-1])
+def _run(tree: Path, repeats: int) -> dict:
+    migrations = str(ROOT / "migrations")
+    return worker(tree, __spec__.name, "--repeats", str(repeats), SUDS_MIGRATIONS=migrations)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -94,10 +87,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", default="b16e0d5")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--repeats", type=int, default=15)
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
+    if a.quick:
+        a.baseline, a.rounds, a.repeats = "HEAD", 1, 2
     if a.worker:
-        print(json.dumps(worker(a.repeats)))
+        print(json.dumps(measure(a.repeats)))
         return 0
     base, now = alternate(a.baseline, a.rounds, lambda path: _run(path, a.repeats))
     print(
@@ -109,9 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     for case in CASES:
         b, n = median(r[case] for r in base), median(r[case] for r in now)
         print(f"| {case} | {b:.1f} | {n:.1f} | {b / n:.2f}x |")
-    same = len({r["digest"] for r in base + now}) == 1
-    print(f"\nschema of a new database: {'identical' if same else 'DIFFERS'}")
-    return 0 if same else 1
+    identical = same(r["digest"] for r in base + now)
+    print(f"\nschema of a new database: {'identical' if identical else 'DIFFERS'}")
+    return 0 if identical else 1
 
 
 if __name__ == "__main__":
