@@ -2,8 +2,8 @@
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/demo_speed.py [--baseline 3454561] [--rounds 3]
-        [--steps simulate discrepancy]
+    .venv/bin/python -m benchmarks.speed.demo_speed [--baseline 3454561] [--rounds 3]
+        [--steps simulate discrepancy] [--quick]
 
 The baseline's `suds_exp` is exported from git (`git archive`) into a temporary folder
 and its simulator kernels compiled there first (not timed). Rounds alternate a worker
@@ -20,6 +20,9 @@ and a sha256 of what it produced (the simulated files; the workflow's result wit
 timings), so the table says whether the working tree's output is identical to the
 baseline's. Wall seconds are only meaningful on an idle machine; CPU seconds are not
 lowered by running on more threads (the simulator's trials run in parallel), wall is.
+
+``--baseline`` may also be a folder (a checkout). ``--quick``: the working tree against
+itself, one round of ``simulate`` on a one-trial design of 2 cycles (a smoke run).
 """
 
 from __future__ import annotations
@@ -27,26 +30,23 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-from learner_speed import _export  # noqa: E402  (git archive of the baseline)
+from benchmarks._harness import ROOT, baseline_tree, run_in, same, speedup, worker
 
 STEPS = ("simulate", "discrepancy")
+#: ``--quick``'s design: one trial of two cycles.
+QUICK_DESIGN = {"gaits": ("O",), "frequencies_hz": (1.0,), "repeats": 1, "cycles": (2, 2)}
 
 
-def _simulate(tmp: Path) -> str:
+def _simulate(tmp: Path, quick: bool = False) -> str:
     from suds_exp.sim import simulate_dataset
 
-    simulate_dataset(tmp, seed=0, progress=False)
+    simulate_dataset(tmp, seed=0, progress=False, **(QUICK_DESIGN if quick else {}))
     h = hashlib.sha256()
     for path in sorted(tmp.rglob("*")):
         if path.is_file():
@@ -55,7 +55,7 @@ def _simulate(tmp: Path) -> str:
     return h.hexdigest()[:16]
 
 
-def _discrepancy(tmp: Path) -> str:
+def _discrepancy(tmp: Path, quick: bool = False) -> str:
     from suds_exp.workflows.hidden_effects import demo_discrepancy
 
     found = demo_discrepancy(effect="body_inertia", seed=0, out=tmp / "report")
@@ -63,7 +63,7 @@ def _discrepancy(tmp: Path) -> str:
     return hashlib.sha256(json.dumps(found, default=repr, sort_keys=True).encode()).hexdigest()[:16]
 
 
-def worker(step: str) -> dict:
+def measure(step: str, quick: bool = False) -> dict:
     """{cpu, wall, digest, threads, suds_exp} of one run of ``step`` in this process."""
     import numba
 
@@ -72,7 +72,7 @@ def worker(step: str) -> dict:
     run = {"simulate": _simulate, "discrepancy": _discrepancy}[step]
     with tempfile.TemporaryDirectory(prefix="suds-demo-speed-") as tmp:
         c0, w0 = time.process_time(), time.perf_counter()
-        digest = run(Path(tmp))
+        digest = run(Path(tmp), quick)
         cpu, wall = time.process_time() - c0, time.perf_counter() - w0
     return {
         "cpu": cpu,
@@ -83,34 +83,29 @@ def worker(step: str) -> dict:
     }
 
 
-def _run(path: Path, *args: str) -> str:
-    env = dict(os.environ, PYTHONPATH=str(path))
-    res = subprocess.run(
-        [sys.executable, *args], env=env, check=True, capture_output=True, text=True, cwd=path
-    )
-    return res.stdout.splitlines()[-1]
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="3454561")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--steps", nargs="+", choices=STEPS, default=list(STEPS))
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", choices=STEPS, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:
-        print(json.dumps(worker(a.worker)))
+        print(json.dumps(measure(a.worker, a.quick)))
         return 0
-    with tempfile.TemporaryDirectory(prefix="suds-baseline-") as tmp:
-        _export(a.baseline, Path(tmp))
-        _run(Path(tmp), "-m", "suds_exp.sim.precompile")  # its kernels' compile, untimed
-        _run(ROOT, "-m", "suds_exp.sim.precompile")
+    if a.quick:
+        a.baseline, a.rounds, a.steps = str(ROOT), 1, ["simulate"]
+    quick = ["--quick"] if a.quick else []
+    with baseline_tree(a.baseline) as tree:
+        run_in(tree, "-m", "suds_exp.sim.precompile")  # its kernels' compile, untimed
+        run_in(ROOT, "-m", "suds_exp.sim.precompile")
         runs: dict[str, tuple[list, list]] = {}
         for step in a.steps:
             base, now = runs.setdefault(step, ([], []))
             for _ in range(a.rounds):
-                base.append(json.loads(_run(Path(tmp), __file__, "--worker", step)))
-                now.append(json.loads(_run(ROOT, __file__, "--worker", step)))
+                base.append(worker(tree, __spec__.name, step, *quick))
+                now.append(worker(ROOT, __spec__.name, step, *quick))
     first = next(iter(runs.values()))
     print(
         f"## Demo steps, {a.rounds} rounds alternating; baseline {a.baseline} "
@@ -123,13 +118,13 @@ def main(argv=None) -> int:
     )
     print("|---|---|---|---|---|---|---|")
     for step, (base, now) in runs.items():
-        ratios = sorted(b["wall"] / n["wall"] for b, n in zip(base, now, strict=True))
-        same = len({r["digest"] for r in base + now}) == 1
+        identical = same(r["digest"] for r in base + now)
+        wall = speedup((r["wall"] for r in base), (r["wall"] for r in now))
         print(
             f"| {step} | {median(r['cpu'] for r in base):.1f} | "
             f"{median(r['cpu'] for r in now):.1f} | {median(r['wall'] for r in base):.1f} | "
-            f"{median(r['wall'] for r in now):.1f} | {median(ratios):.2f}x "
-            f"[{ratios[0]:.2f}, {ratios[-1]:.2f}] | {'identical' if same else 'DIFFER'} |"
+            f"{median(r['wall'] for r in now):.1f} | {wall} "
+            f"| {'identical' if identical else 'DIFFER'} |"
         )
     return 0
 

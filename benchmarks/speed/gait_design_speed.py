@@ -2,8 +2,8 @@
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/gait_design_speed.py [--baseline 650de56] [--rounds 3]
-        [--cases "GMR verify" GMR "GMR+SUDS verify"]
+    .venv/bin/python -m benchmarks.speed.gait_design_speed [--baseline 650de56] [--rounds 3]
+        [--cases "GMR verify" GMR "GMR+SUDS verify"] [--quick]
 
 The baseline's `suds_exp` and `cli.py` are exported from git (`git archive`) into a
 temporary folder and its simulator kernels compiled there first (not timed). Rounds
@@ -22,6 +22,8 @@ Each worker, in its own code:
   predicted and achieved motions and stored iterations are identical to the baseline's.
 
 Exit status 1 if any case's outputs differ (the check that results did not drift).
+``--baseline`` may also be a folder (a checkout). ``--quick``: the working tree against
+itself, one round of the ``GMR`` case (a smoke run).
 """
 
 from __future__ import annotations
@@ -30,18 +32,13 @@ import argparse
 import hashlib
 import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-from demo_speed import _run  # noqa: E402  (a worker on one tree)
-from learner_speed import alternate  # noqa: E402  (rounds on an export of the baseline)
+from benchmarks._harness import ROOT, alternate, run_in, same, speedup, worker
 
 #: The design's options beside the learner and --verify (the default test's design).
 DESIGN = ["--bound", "1.3", "--iterations", "2", "--order", "1"]
@@ -95,7 +92,7 @@ def _digest(printed: str, db: Path) -> str:
     return h.hexdigest()[:16]
 
 
-def worker(case: str) -> dict:
+def measure(case: str) -> dict:
     """{wall, cpu, digest, suds_exp} of one design of ``case`` in this process."""
     import suds_exp
     from cli import app
@@ -118,19 +115,17 @@ def worker(case: str) -> dict:
     return {"cpu": cpu, "wall": wall, "digest": digest, "suds_exp": suds_exp.__file__}
 
 
-def _runner(commit: str, cases: list[str]):
-    """``run(path)`` for `alternate`: every case's worker on the tree at ``path``. The
-    baseline's export (`learner_speed`'s: `suds_exp` alone) gets its own `cli.py` and its
-    kernels compiled on first use, untimed."""
+def _runner(cases: list[str]):
+    """``run(tree)`` for `alternate`: every case's worker on ``tree``; a baseline's kernels
+    are compiled on its first use, untimed."""
 
-    def run(path: Path) -> dict:
-        if path != ROOT and not (path / "cli.py").exists():
-            cli = subprocess.run(
-                ["git", "show", f"{commit}:cli.py"], cwd=ROOT, check=True, capture_output=True
-            ).stdout
-            (path / "cli.py").write_bytes(cli)
-            _run(path, "-m", "suds_exp.sim.precompile")
-        return {case: json.loads(_run(path, __file__, "--worker", case)) for case in cases}
+    compiled = {ROOT}
+
+    def run(tree: Path) -> dict:
+        if tree not in compiled:
+            run_in(tree, "-m", "suds_exp.sim.precompile")
+            compiled.add(tree)
+        return {case: worker(tree, __spec__.name, case) for case in cases}
 
     return run
 
@@ -140,13 +135,16 @@ def main(argv=None) -> int:
     ap.add_argument("--baseline", default="650de56")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--cases", nargs="+", choices=list(CASES), default=list(DEFAULT_CASES))
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", choices=list(CASES), help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:
-        print(json.dumps(worker(a.worker)))
+        print(json.dumps(measure(a.worker)))
         return 0
-    _run(ROOT, "-m", "suds_exp.sim.precompile")  # the kernels' compile, untimed
-    base, now = alternate(a.baseline, a.rounds, _runner(a.baseline, a.cases))
+    if a.quick:
+        a.baseline, a.rounds, a.cases = str(ROOT), 1, ["GMR"]
+    run_in(ROOT, "-m", "suds_exp.sim.precompile")  # the kernels' compile, untimed
+    base, now = alternate(a.baseline, a.rounds, _runner(a.cases))
     runs = {case: ([r[case] for r in base], [r[case] for r in now]) for case in a.cases}
     first = runs[a.cases[0]]
     print(
@@ -161,15 +159,14 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|---|---|")
     drift = False
     for case, (base, now) in runs.items():
-        ratios = sorted(b["wall"] / n["wall"] for b, n in zip(base, now, strict=True))
-        same = len({r["digest"] for r in base + now}) == 1
-        drift |= not same
+        identical = same(r["digest"] for r in base + now)
+        drift |= not identical
         print(
             f"| {case} | {median(r['wall'] for r in base):.2f} | "
             f"{median(r['wall'] for r in now):.2f} | {median(r['cpu'] for r in base):.2f} | "
-            f"{median(r['cpu'] for r in now):.2f} | {median(ratios):.2f}x "
-            f"[{ratios[0]:.2f}, {ratios[-1]:.2f}] | "
-            f"{'identical (' + base[0]['digest'] + ')' if same else 'DIFFER'} |"
+            f"{median(r['cpu'] for r in now):.2f} | "
+            f"{speedup((b['wall'] for b in base), (n['wall'] for n in now))} | "
+            f"{'identical (' + base[0]['digest'] + ')' if identical else 'DIFFER'} |"
         )
     return 1 if drift else 0
 
