@@ -2,7 +2,7 @@
 
 Usage::
 
-    .venv/bin/python benchmarks/scale.py --sizes 0.1,1,5,10 --folder /tmp/scale [--rounds 3]
+    .venv/bin/python -m benchmarks.speed.scale --sizes 0.1,1,5,10 --folder /tmp/scale [--rounds 3]
 
 For each size (millions of results) a database is built once in ``--folder`` (kept and
 reused by later runs): a finished campaign ``scale`` of the paper's grid (15 x 15
@@ -26,7 +26,8 @@ load) and peak resident memory (the process's ru_maxrss) are recorded:
 
 It prints medians per size and the growth exponent of time and of memory between
 consecutive sizes (log(t2/t1) / log(n2/n1); 1 is linear, 0 flat). ``--json`` writes the
-figures as one JSON document.
+figures as one JSON document. ``--quick``: one round at 0.001M results in a new temporary
+folder, the findings with 20 replicates (a smoke run, no figure).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -42,10 +44,8 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-# this tree's suds_exp, unless PYTHONPATH names the checkout to measure
-if not os.environ.get("PYTHONPATH"):
-    sys.path.insert(0, str(ROOT))
+from benchmarks._data import paper_like_samples
+from benchmarks._harness import ROOT
 
 CAMPAIGN = "scale"
 PAIRS_X_LEARNERS = 15 * 15 * 5
@@ -55,10 +55,7 @@ COMMANDS = ("report", "findings", "status", "sql", "resume")
 
 
 def scale_samples():
-    """Synthetic-swimmer samples of the 15 paper conditions (`benchmarks/campaign.py`)."""
-    sys.path.insert(0, str(ROOT))
-    from benchmarks.campaign import paper_like_samples
-
+    """Synthetic-swimmer samples of the 15 paper conditions (`benchmarks._data`)."""
     return paper_like_samples()
 
 
@@ -118,13 +115,13 @@ def command(name: str, db: Path, out: Path, findings_boots: int) -> list[str]:
     if name == "sql":
         query = "SELECT model, count(*), avg(rmse_vx) FROM results GROUP BY model"
         return [*cli, "sql", query, "--db", str(db)]
-    return [sys.executable, __file__, "--resume-worker", str(db)]
+    return [sys.executable, "-m", __spec__.name, "--resume-worker", str(db)]
 
 
 def run_measured(argv: list[str]) -> dict:
     """`measure` with the child's own ru_maxrss: Popen reaps the child, so the peak is
     read from a wrapper that reports it."""
-    wrapped = [sys.executable, __file__, "--measure", json.dumps(argv)]
+    wrapped = [sys.executable, "-m", __spec__.name, "--measure", json.dumps(argv)]
     out = subprocess.run(wrapped, capture_output=True, text=True)
     if out.returncode:
         raise SystemExit(f"{' '.join(argv)} failed:\n{out.stderr[-3000:]}")
@@ -164,6 +161,7 @@ def main(argv=None) -> int:
     ap.add_argument("--commands", default=",".join(COMMANDS))
     ap.add_argument("--findings-boots", type=int, default=400)
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--resume-worker", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--measure", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
@@ -174,8 +172,13 @@ def main(argv=None) -> int:
         print(json.dumps(measure_child(json.loads(a.measure))))
         return 0
 
-    env_path = os.environ.get("PYTHONPATH") or str(ROOT)
-    os.environ["PYTHONPATH"] = env_path
+    if a.quick:
+        a.sizes, a.rounds, a.findings_boots = "0.001", 1, 20
+        a.folder = Path(tempfile.mkdtemp(prefix="suds_scale_quick_"))
+    # the commands' processes import this PYTHONPATH's suds_exp (this tree's by default),
+    # the measuring wrapper this tree's benchmarks
+    paths = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    os.environ["PYTHONPATH"] = os.pathsep.join([*paths, str(ROOT)] if str(ROOT) not in paths else paths)
     a.folder.mkdir(parents=True, exist_ok=True)
     sizes = [float(s) for s in a.sizes.split(",")]
     commands = a.commands.split(",")
@@ -224,6 +227,8 @@ def main(argv=None) -> int:
         print(f"{name:10}{cells}   " + ", ".join(exps))
     if a.json:
         a.json.write_text(json.dumps({str(k): v for k, v in table.items()}, indent=1))
+    if a.quick:
+        shutil.rmtree(a.folder)
     return 0
 
 
