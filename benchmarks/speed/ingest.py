@@ -4,34 +4,41 @@ Prints the median wall time (over repeats) of `ingest_paths` on N files of F fra
 11 markers, and, as the baseline measured in the same run, the time a bare
 ``pandas.read_csv`` takes just to parse the same files (no validation, no database).
 
-    .venv/bin/python benchmarks/ingest.py [--files 60] [--frames 4000] [--repeats 3]
+    .venv/bin/python -m benchmarks.speed.ingest [--files 60] [--frames 4000] [--repeats 3]
+
+``--quick``: 2 files of 200 frames, once (a smoke run, no figure). The QTM text comes
+from the test suite's helpers (`tests.helpers`), so run it from the repository root.
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.ingest import ROLES, ingest_paths  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
-from tests.helpers import qtm_text, random_track  # noqa: E402
+from suds_exp.ingest import ROLES, ingest_paths
+from suds_exp.store import Store
+from tests.helpers import qtm_text, random_track
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--files", type=int, default=60)
     parser.add_argument("--frames", type=int, default=4000)
     parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
-    folder = Path(tempfile.mkdtemp())
+    parser.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.files, args.frames, args.repeats = 2, 200, 1
+    with tempfile.TemporaryDirectory(prefix="suds-ingest-bench-") as tmp:
+        measure(Path(tmp), args)
+
+
+def measure(folder: Path, args) -> None:
     files = []
     for i in range(args.files):
         path = folder / f"t{i:03d}.tsv"

@@ -3,7 +3,7 @@ errors against the simulator's truth.
 
 Usage::
 
-    .venv/bin/python benchmarks/preprocess.py [--db FILE] [--repeats 3] [--json] [--body FILE]
+    .venv/bin/python -m benchmarks.speed.preprocess [--db FILE] [--repeats 3] [--json] [--body FILE]
 
 Data: the default design of `suds-exp simulate` (5 gaits x 3 frequencies x 4 repeats,
 10-30 cycles, seed 0: 60 trials, about 240k frames at 100 Hz), simulated into a temporary
@@ -19,6 +19,9 @@ Figures:
   and wz (rad/s) as a percentage of the RMS of the true vx, both against the raw truth
   and against the truth pose passed through the same differentiator (``*_band``);
   r_a (rad); phase vs the commanded phase after one offset per trial (rad).
+
+``--quick``: one run on 8 trials of 4 cycles (O and D+ at 0.5 and 1 Hz, 2 repeats), a
+smoke run whose figures mean nothing.
 """
 
 from __future__ import annotations
@@ -33,16 +36,17 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from suds_exp.body import load_body, preprocess_body
+from suds_exp.commands.simulate import simulate_command
+from suds_exp.preprocess import preprocess
+from suds_exp.preprocess.truth import truth_errors
+from suds_exp.store import Store
 
-from suds_exp.body import load_body, preprocess_body  # noqa: E402
-from suds_exp.commands.simulate import simulate_command  # noqa: E402
-from suds_exp.preprocess import preprocess  # noqa: E402
-from suds_exp.preprocess.truth import truth_errors  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+#: ``--quick``'s design (keywords of `simulate_command`).
+QUICK_DESIGN = {"gaits": ("O", "D+"), "frequencies_hz": (0.5, 1.0), "repeats": 2, "cycles": (4, 4)}
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--db", type=Path, help="Database already holding the dataset.")
     parser.add_argument("--repeats", type=int, default=3)
@@ -50,7 +54,11 @@ def main() -> None:
     parser.add_argument(
         "--body", help="Preprocess through this body description (e.g. swimmer) instead."
     )
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = parser.parse_args(argv)
+    design = {}
+    if args.quick:
+        args.repeats, design = 1, QUICK_DESIGN
 
     with tempfile.TemporaryDirectory(prefix="suds-prep-bench-") as tmp:
         tmp = Path(tmp)
@@ -58,7 +66,7 @@ def main() -> None:
         if source is None:
             source = tmp / "source.duckdb"
             t0 = time.perf_counter()
-            simulate_command(tmp / "data", store=Store(source), seed=0)
+            simulate_command(tmp / "data", store=Store(source), seed=0, **design)
             print(f"simulated and ingested in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
         runs, result, copy = [], None, None
         for i in range(args.repeats):

@@ -3,7 +3,9 @@
 Writes the results into a temporary database once, then writes the full report
 ``--repeats`` times and prints each wall time and the median. Target: under 60 s.
 
-    .venv/bin/python benchmarks/report.py [--rows 100000] [--repeats 3]
+    .venv/bin/python -m benchmarks.speed.report [--rows 100000] [--repeats 3]
+
+``--quick``: one report of one draw a cell (a smoke run, no figure).
 """
 
 from __future__ import annotations
@@ -23,11 +25,14 @@ N_CYCLES = (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 21, 30, 39, 48)  # the paper's sweep
 TARGET_S = 60.0
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rows", type=int, default=100_000, help="approximate number of results")
     parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.rows, args.repeats = 1, 1
     per_boot = 5 * 15 * 15 * len(N_CYCLES)
     n_boot = max(1, math.ceil(args.rows / per_boot))
     frame = synthetic_results("bench", n_boot=n_boot, n_cycles=N_CYCLES, seed=7)

@@ -1,6 +1,6 @@
 """Simulator benchmark: speed on the default dataset, and the motion tables of issue 3.
 
-Run: .venv/bin/python benchmarks/sim.py [--runs 3] [--out reports/sim-benchmark]
+Run: .venv/bin/python -m benchmarks.speed.sim [--runs 3] [--out reports/sim-benchmark]
 
 Prints
 - simulated seconds per second per core on the default dataset (5 gaits x 3 frequencies
@@ -12,22 +12,23 @@ Prints
   locked (same actuated drive);
 - net displacement per cycle of each gait at each frequency;
 and writes one figure of a simulated trial's path to --out (not in git).
+
+``--quick``: one run on a one-trial design (O at 1 Hz, 2 cycles), the motion tables at 2
+cycles, the figure into a temporary folder (a smoke run, no figure to quote).
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.sim import (  # noqa: E402
+from benchmarks._harness import table
+from suds_exp.sim import (
     FREQUENCIES_HZ,
     GAITS,
     SimConfig,
@@ -40,9 +41,16 @@ from suds_exp.sim import (  # noqa: E402
 )
 
 
-def speed(runs: int, effects: list[str] = ()) -> None:
+#: ``--quick``'s design: one trial of two cycles.
+QUICK_DESIGN = {"gaits": ("O",), "frequencies_hz": (1.0,), "repeats": 1, "cycles": (2, 2)}
+
+
+def speed(runs: int, effects: list[str] = (), design: dict | None = None) -> None:
+    """Physics and `simulate_dataset` speed on the default dataset (or ``design``, the
+    keywords of `plan_trials`)."""
+    design = design or {}
     cfg = apply_effects(SimConfig(), effects, param="--set")
-    specs = plan_trials()
+    specs = plan_trials(**design)
     simulate_trials(specs[:1], cfg)  # compile / load the numba cache
     cpu, wall = [], []
     robot_s = 0.0
@@ -54,7 +62,7 @@ def speed(runs: int, effects: list[str] = ()) -> None:
         cpu.append(robot_s / (c1 - c0))
         wall.append(robot_s / (w1 - w0))
     worst = max(float(np.nanmax(t["residual"])) for t in truths)
-    print(f"default dataset: {len(specs)} trials, {robot_s:.0f} s of robot time")
+    print(f"{'design' if design else 'default dataset'}: {len(specs)} trials, {robot_s:.0f} s of robot time")
     print(
         f"physics: {statistics.median(cpu):.0f}x real time per CPU-second "
         f"(runs {', '.join(f'{v:.0f}' for v in cpu)}); "
@@ -64,19 +72,13 @@ def speed(runs: int, effects: list[str] = ()) -> None:
     print(f"max force/torque residual of any step: {worst:.2e} (scaled; tol {cfg.solver.tol})")
     with tempfile.TemporaryDirectory() as tmp:
         w0, c0 = time.perf_counter(), time.process_time()
-        ds = simulate_dataset(tmp, cfg)
+        ds = simulate_dataset(tmp, cfg, **design)
         c1, w1 = time.process_time(), time.perf_counter()
     print(
         f"simulate_dataset (physics + markers + files): "
         f"{ds.simulated_seconds / (c1 - c0):.0f}x per CPU-second, "
         f"{ds.simulated_seconds / (w1 - w0):.0f}x per wall-clock second"
     )
-
-
-def _table(header: list[str], rows: list[list[str]]) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines)
 
 
 def motion_tables(cycles: int = 10) -> dict:
@@ -101,14 +103,14 @@ def motion_tables(cycles: int = 10) -> dict:
         disp_rows.setdefault(spec.gait, {})[f] = d
     print("\nForward speed (mean body vx) and RMS vx, mm/s, flippers free vs locked")
     print(
-        _table(
+        table(
             ["gait", "f (Hz)", "free mean", "free RMS", "locked mean", "locked RMS", "free/locked"],
             speed_rows,
         )
     )
     print("\nNet displacement per cycle, mm (nominal robot, flippers free)")
     print(
-        _table(
+        table(
             ["gait"] + [f"{f:.3g} Hz" for f in FREQUENCIES_HZ],
             [[g] + [f"{disp_rows[g][f]:.1f}" for f in FREQUENCIES_HZ] for g in GAITS],
         )
@@ -141,7 +143,7 @@ def path_figure(specs, truths, out: Path) -> Path:
     return path
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", type=Path, default=Path("reports/sim-benchmark"))
@@ -149,12 +151,17 @@ def main() -> None:
         "--set", nargs="*", default=[], help="effects over the nominal robot, EFFECT.PARAM=VALUE"
     )
     ap.add_argument("--speed-only", action="store_true", help="skip the motion tables")
-    args = ap.parse_args()
-    speed(args.runs, args.set)
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.runs = 1
+    speed(args.runs, args.set, QUICK_DESIGN if args.quick else None)
     if args.speed_only:
         return
-    res = motion_tables()
-    print(f"\nwrote {path_figure(res['specs'], res['free'], args.out)}")
+    res = motion_tables(cycles=2 if args.quick else 10)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) if args.quick else args.out
+        print(f"\nwrote {path_figure(res['specs'], res['free'], out)}")
 
 
 if __name__ == "__main__":
