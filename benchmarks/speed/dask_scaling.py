@@ -4,9 +4,9 @@ time, and whether the rows agree.
 
 Usage::
 
-    .venv/bin/python benchmarks/dask_scaling.py                        # a small dataset
-    .venv/bin/python benchmarks/dask_scaling.py --boots 10 --rounds 3
-    .venv/bin/python benchmarks/dask_scaling.py \
+    .venv/bin/python -m benchmarks.speed.dask_scaling                  # a small dataset
+    .venv/bin/python -m benchmarks.speed.dask_scaling --boots 10 --rounds 3
+    .venv/bin/python -m benchmarks.speed.dask_scaling \
         --worker-env DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False
 
 The dataset (4 conditions, 2 repeats of 10 cycles, simulated once into a temporary
@@ -18,7 +18,7 @@ them by default; ``--nanny`` keeps dask's nanny process), stopped after each run
 ``--worker-env`` sets environment variables of the dask workers only (to test what slows
 them down). Figures are medians over
 ``--rounds``; "job" is a job's ``fit_seconds + predict_seconds`` as the results table
-stores it.
+stores it. ``--quick``: phase-only, one draw of 2 cycles, one dask worker (a smoke run).
 """
 
 from __future__ import annotations
@@ -175,7 +175,10 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", default="1,2", help="dask worker counts to run")
     ap.add_argument("--worker-env", action="append", default=[], metavar="NAME=VALUE")
     ap.add_argument("--nanny", action="store_true", help="workers under a nanny process")
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     a = ap.parse_args(argv)
+    if a.quick:
+        a.models, a.boots, a.train_cycles, a.workers, a.rounds = "phase-only", 1, 2, "1", 1
     env = dict(item.split("=", 1) for item in a.worker_env)
     counts = [int(n) for n in a.workers.split(",")]
     with tempfile.TemporaryDirectory(prefix="suds-dask-") as tmp:

@@ -5,9 +5,9 @@ predictions as they were (bit-identical where the arithmetic is unchanged).
 
 Usage (from the repository root)::
 
-    .venv/bin/python benchmarks/learner_outputs.py --save /tmp/before.npz
+    .venv/bin/python -m benchmarks.speed.learner_outputs --save /tmp/before.npz
     # ... change a learner ...
-    .venv/bin/python benchmarks/learner_outputs.py --compare /tmp/before.npz
+    .venv/bin/python -m benchmarks.speed.learner_outputs --compare /tmp/before.npz
 
 Data: the closed-form synthetic swimmer (`suds_exp.testing.synthetic_swimmer`,
 passive="travel", velocity="finsler", seeds fixed), 30 training cycles of O at 1/2 Hz
@@ -17,18 +17,21 @@ different trial of O at 1/2 Hz, of O at 1 Hz and of D+ at 1/2 Hz. Each learner o
 variants (dilation, filter, history, BIC) are fitted once; the record holds every
 prediction array, keyed by learner and test trial. `--compare` prints, per array, the
 largest absolute difference and whether the bits are equal; exit status 1 if any
-array differs by more than `--tol` (default 0: bit-identical).
+array differs by more than `--tol` (default 0: bit-identical). ``--quick``: phase-only and
+TLS recorded into a temporary file and compared with it (a smoke run).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from learner_setup import GMR_VARIANTS, PAPER, SURVEY, swimmer_samples
 
+from benchmarks._data import GMR_VARIANTS, PAPER, SURVEY, swimmer_samples
 from suds_exp.models import make_model
 
 CASES = [*PAPER, *GMR_VARIANTS, *SURVEY]
@@ -46,10 +49,11 @@ def data():
     return train, tests
 
 
-def record() -> dict[str, np.ndarray]:
+def record(cases=CASES) -> dict[str, np.ndarray]:
+    """{"learner | test trial": predictions} of each of ``cases``."""
     train, tests = data()
     out = {}
-    for name, params in CASES:
+    for name, params in cases:
         m = make_model(name, **params).fit(train)
         label = name + "".join(f" {k}={v}" for k, v in sorted(params.items()))
         for tname, test in tests.items():
@@ -62,14 +66,24 @@ def main(argv=None) -> int:
     g = ap.add_mutually_exclusive_group(required=True)
     g.add_argument("--save", help="write the record to this .npz file")
     g.add_argument("--compare", help="compare with the record in this .npz file")
+    g.add_argument("--quick", action="store_true", help="a smoke run: record, then compare")
     ap.add_argument("--tol", type=float, default=0.0, help="largest absolute difference allowed")
     a = ap.parse_args(argv)
+    if a.quick:
+        with tempfile.TemporaryDirectory() as tmp:
+            path = str(Path(tmp) / "record.npz")
+            np.savez(path, **record(PAPER[:2]))
+            return compare(dict(np.load(path)), record(PAPER[:2]), a.tol)
     now = record()
     if a.save:
         np.savez(a.save, **now)
         print(f"recorded {len(now)} prediction arrays in {a.save}")
         return 0
-    old = dict(np.load(a.compare))
+    return compare(dict(np.load(a.compare)), now, a.tol)
+
+
+def compare(old: dict, now: dict, tol: float) -> int:
+    """Print each array's largest difference; 1 if any differs by more than ``tol``."""
     bad = 0
     for key in sorted(set(old) | set(now)):
         if key not in old or key not in now:
@@ -80,10 +94,10 @@ def main(argv=None) -> int:
             old[key].view(np.uint64), now[key].view(np.uint64)
         )
         diff = float(np.nanmax(np.abs(old[key] - now[key]))) if not same else 0.0
-        ok = same or diff <= a.tol
+        ok = same or diff <= tol
         bad += not ok
         print(f"{'bit-identical' if same else f'max |diff| {diff:.3g}':>22}  {key}")
-    print(f"{len(now) - bad} of {len(set(old) | set(now))} arrays within tol={a.tol}")
+    print(f"{len(now) - bad} of {len(set(old) | set(now))} arrays within tol={tol}")
     return 1 if bad else 0
 
 

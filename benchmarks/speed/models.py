@@ -2,8 +2,8 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/models.py [--repeats 7] [--boots 3]
-        [--data sim|synthetic]
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.speed.models [--repeats 7] [--boots 3]
+        [--data sim|synthetic] [--quick]
 
 Data: by default the physics simulator (`suds_exp.sim`, nominal configuration), with
 r_a = (phi1, phi2), r_p = the four flipper angles (k = 4), rates by central differences,
@@ -34,6 +34,9 @@ Sections:
    held-out RMSE and the fit CPU seconds of the default, L-BFGS with at most 100 and
    200 iterations; then the former default (Adam with early stopping) against L-BFGS on
    four test trials (O at 1/2, 1 and 1/3 Hz, D+ at 1/2 Hz).
+
+``--quick``: section 1 alone, phase-only and TLS once, on the synthetic swimmer (a smoke
+run, no figure).
 """
 
 from __future__ import annotations
@@ -44,8 +47,8 @@ from statistics import median
 
 import numpy as np
 import pandas as pd
-from learner_setup import PAPER, SURVEY, swimmer_samples
 
+from benchmarks._data import PAPER, SURVEY, swimmer_samples
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
 from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
@@ -123,11 +126,13 @@ def _rmse(pred, test):
     return float(np.sqrt(((pred["vx"] - test["vx"]) ** 2).mean()))
 
 
-def timings(trials, repeats):
+def timings(trials, repeats, learners=None):
+    """Section 1 for ``learners`` ((name, parameters) pairs; default: the paper's and the
+    survey's)."""
     base = trials[("O", 0.5)]
     train = {30: _window(base[0], 0, 30), 48: pd.concat([base[0], _window(base[1], 0, 18)])}
     test = _window(base[2], 0, 20)
-    learners = [*PAPER, *SURVEY]
+    learners = learners or [*PAPER, *SURVEY]
     print("\n## 1. Fit and predict time (s), medians of", repeats, "runs; test trial", len(test))
     print(
         "| learner | train samples | fit s | predict s | fit+predict s | fit+predict CPU s "
@@ -156,6 +161,8 @@ def timings(trials, repeats):
                 f"{median(cpus):.4f} | {_rmse(p, test):.2f} |"
             )
     five = LEARNERS
+    if any((n, c) not in cpu for n in five for c in train):
+        return
     print("\nfit+predict CPU seconds against the paper's five together (measured mode):")
     for n_cycles in train:
         base = sum(cpu[(n, n_cycles)] for n in five)
@@ -319,21 +326,26 @@ def mlp_curve(trials, epochs=(5, 10, 20, 30, 40, 60, 80, 100, 150, 200)):
             print(f"| {name} | {label} | {np.mean(cpu):.2f} | {cells} |")
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--boots", type=int, default=3)
     ap.add_argument("--data", choices=("sim", "synthetic"), default="sim")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation", "curve"))
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
+    learners = None
+    if args.quick:
+        args.data, args.repeats, args.skip = "synthetic", 1, ["gmr", "ablation", "curve"]
+        learners = PAPER[:2]
     conditions = [("O", 0.5), ("O", 1.0), ("O", 1 / 3), ("D+", 0.5)]
     t0 = time.perf_counter()
     make = _sim_trials if args.data == "sim" else _synthetic_trials
     trials = make(conditions, 30, 3, args.seed)
     print(f"# Learner benchmark ({args.data} data, built in {time.perf_counter() - t0:.1f} s)")
     if "timing" not in args.skip:
-        timings(trials, args.repeats)
+        timings(trials, args.repeats, learners)
     if "gmr" not in args.skip:
         versus_gmr(trials, args.repeats)
     if "ablation" not in args.skip:
