@@ -2,7 +2,7 @@
 
 Usage (from the repository root)::
 
-    python3 benchmarks/fresh_clone.py [--baseline b16e0d5] [--rounds 3] [--target test]
+    python3 -m benchmarks.speed.fresh_clone [--baseline b16e0d5] [--rounds 3] [--target test]
 
 What a newcomer does (the README's commands), timed: each round clones the repository
 into a new folder beside it (so ``../shared`` is the same one the checkout sees), checks
@@ -15,7 +15,9 @@ Uncommitted changes are not measured: commit first.
 Caches outside the clone stay as they are between rounds (uv's download cache in
 ``~/.cache/uv``): the figures are those of a machine that has installed once before,
 as in the project's idle re-measurements; a cold cache adds the download time.
-The clones are removed afterwards unless ``--keep``.
+The clones are removed afterwards unless ``--keep``. ``--quick``: one round, the clones
+and ``make --dry-run`` in place of the install and the target (a smoke run of the
+machinery, no install).
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-ROOT = Path(__file__).resolve().parents[1]
+from benchmarks._harness import ROOT
 
 
 def _git(*args: str, cwd: Path = ROOT) -> str:
@@ -67,7 +69,7 @@ def _outcome(tail: str) -> str:
     return ", ".join(found) if found else tail.splitlines()[-1] if tail else ""
 
 
-def one_round(commit: str, target: str, keep: bool) -> dict:
+def one_round(commit: str, target: str, keep: bool, dry_run: bool = False) -> dict:
     """Clone ``commit`` beside the repository and time the install and ``make target``."""
     # beside the repository: the clone's ../shared is the checkout's
     repo = Path(tempfile.mkdtemp(prefix=".fresh-clone-", dir=ROOT.parent))
@@ -75,10 +77,11 @@ def one_round(commit: str, target: str, keep: bool) -> dict:
         _git("clone", "-q", str(ROOT), str(repo))
         _git("checkout", "-q", commit, cwd=repo)
         load = os.getloadavg()[0]
-        install, tail, rc = _timed(["make", ".venv/.installed"], repo)
+        make = ["make", "--dry-run"] if dry_run else ["make"]
+        install, tail, rc = _timed([*make, ".venv/.installed"], repo)
         if rc != 0:
             raise SystemExit(f"{commit}: the install failed:\n{tail}")
-        run, tail, rc = _timed(["make", target], repo)
+        run, tail, rc = _timed([*make, target], repo)
         return {
             "commit": commit,
             "load": load,
@@ -99,7 +102,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rounds", type=int, default=3, help="rounds per side")
     ap.add_argument("--target", default="test", choices=("test", "demo"))
     ap.add_argument("--keep", action="store_true", help="keep the clones")
+    ap.add_argument("--quick", action="store_true", help="a smoke run: make --dry-run")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.rounds = 1
     # a terminated run still removes its clone (the `finally` of `one_round`)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
 
@@ -113,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{'make':>8} {'total':>8}  outcome")  # fmt: skip
     for r in range(1, args.rounds + 1):
         for side, commit in sides.items():
-            row = one_round(commit, args.target, args.keep) | {"side": side, "round": r}
+            row = one_round(commit, args.target, args.keep, args.quick) | {"side": side, "round": r}
             rows.append(row)
             print(
                 f"{r:>5} {side:>8} {commit:>8} {row['load']:>5.2f} {row['install']:>7.1f}s "
