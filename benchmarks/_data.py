@@ -134,3 +134,27 @@ def swimmer_samples(n_cycles: int, gait: str, frequency_hz: float, seed: int, tr
         seed=seed,
         first_trial_id=trial_id,
     )
+
+
+#: A simulated design small enough for a smoke run (keywords of `simulate_dataset`): 2
+#: gaits x 2 frequencies x 2 repeats of 4 cycles.
+QUICK_DESIGN = {"gaits": ("O", "D+"), "frequencies_hz": (0.5, 1.0), "repeats": 2, "cycles": (4, 4)}
+
+
+def simulated_database(db: Path, design: dict | None = None, seed: int = 0, config=None) -> str:
+    """Simulate ``design`` (keywords of `simulate_dataset`; default the paper's) with the
+    robot ``config`` (default nominal), ingest it into the new database ``db`` and
+    preprocess it with the defaults; returns the preprocessing version's name."""
+    import tempfile
+
+    from suds_exp.ingest import ingest_paths
+    from suds_exp.preprocess import preprocess
+    from suds_exp.sim import simulate_dataset
+    from suds_exp.store import Store
+
+    store = Store(db)
+    store.upgrade()
+    with tempfile.TemporaryDirectory(prefix="suds-bench-data-") as tmp:
+        data = simulate_dataset(tmp, config, seed=seed, **(design or {}))
+        ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=False)
+    return preprocess(store, progress=False).name

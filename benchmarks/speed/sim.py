@@ -40,7 +40,6 @@ from suds_exp.sim import (
     truth_markers,
 )
 
-
 #: ``--quick``'s design: one trial of two cycles.
 QUICK_DESIGN = {"gaits": ("O",), "frequencies_hz": (1.0,), "repeats": 1, "cycles": (2, 2)}
 

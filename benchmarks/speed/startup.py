@@ -23,6 +23,7 @@ from pathlib import Path
 from statistics import median
 
 from benchmarks._harness import ROOT, alternate
+
 COMMANDS = {
     "--version": ["--version"],
     "--help": ["--help"],

@@ -28,17 +28,16 @@ A reduced campaign takes 1.5-4 min on 2 cores (``--jobs``). Rows are appended to
 as settings finish (an interrupted run keeps them; a re-run skips them), and a summary
 (findings holding, on the paper's side, values) is printed for the settings asked for.
 
-    .venv/bin/python benchmarks/calibrate.py --settings nominal,old --out calib.csv
-    .venv/bin/python benchmarks/calibrate.py --search 20 --rng 1 --out calib.csv
-    .venv/bin/python benchmarks/calibrate.py --ablation --out calib.csv
-    .venv/bin/python benchmarks/calibrate.py --settings nominal,calibrated --springs 20,300
+    .venv/bin/python -m benchmarks.studies.calibrate --settings nominal,old --out calib.csv
+    .venv/bin/python -m benchmarks.studies.calibrate --search 20 --rng 1 --out calib.csv
+    .venv/bin/python -m benchmarks.studies.calibrate --ablation --out calib.csv
+    .venv/bin/python -m benchmarks.studies.calibrate --settings nominal,calibrated --springs 20,300
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import sys
 import tempfile
 import time
 import tomllib
@@ -47,20 +46,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.analysis.findings import findings  # noqa: E402
-from suds_exp.campaign import CampaignOptions, run_campaign  # noqa: E402
-from suds_exp.ingest import ingest_paths  # noqa: E402
-from suds_exp.preprocess import preprocess  # noqa: E402
-from suds_exp.sim import (  # noqa: E402
+from suds_exp.analysis.findings import findings
+from suds_exp.campaign import CampaignOptions, run_campaign
+from suds_exp.ingest import ingest_paths
+from suds_exp.preprocess import preprocess
+from suds_exp.sim import (
     SimConfig,
     apply_effects,
     config_from_dict,
     effect_library,
     simulate_dataset,
 )
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.store import Store
 
 #: Effects and their settings that describe a robot's variability (issue 17).
 VARIABILITY_EFFECTS = (

@@ -6,9 +6,9 @@ realistic range with the run's seed), sends it through files -> ingest -> prepro
 runs the workflow from the nominal model. A hit: the hidden effect is named first, its
 interval covers the true value and the held-out gap at least halves.
 
-    .venv/bin/python benchmarks/discrepancy.py --seeds 3 --null-seeds 4 --out bench-disc.csv
-    .venv/bin/python benchmarks/discrepancy.py --timing-only     # default dataset timing
-    .venv/bin/python benchmarks/discrepancy.py --withheld --seeds 5 --out bench-withheld.csv
+    .venv/bin/python -m benchmarks.studies.discrepancy --seeds 3 --null-seeds 4 --out bench-disc.csv
+    .venv/bin/python -m benchmarks.studies.discrepancy --timing-only     # default dataset timing
+    .venv/bin/python -m benchmarks.studies.discrepancy --withheld --seeds 5 --out bench-withheld.csv
 
 `--withheld`: each effect is hidden in the data AND excluded from the candidates
 (`--exclude-candidates`); per effect it prints the wrong-name rate (anything named), the
@@ -21,7 +21,7 @@ parameter (no draw), run at each seed; per value it prints how often the effect 
 first, the candidate's held-out p (raw and adjusted for the other candidates), the
 held-out loss it removes, its fitted value and the gap. For example the spoke oscillation's edge:
 
-    .venv/bin/python benchmarks/discrepancy.py --detection spoke_oscillation \
+    .venv/bin/python -m benchmarks.studies.discrepancy --detection spoke_oscillation \
         --values 1.3,1.4,1.5 --detection-seeds 11,14,15 --out bench-detect.csv
 
 `--form-mismatch`: the same on the effects whose nearest candidate has the same mechanism

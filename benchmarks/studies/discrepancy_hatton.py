@@ -11,7 +11,7 @@ notes' probable relabelling). The pose is integrated from xi; the flipper hinge 
 Markers -> measurement noise -> QTM files -> ingest -> preprocess -> the workflow from
 the nominal model, discovery on.
 
-    .venv/bin/python benchmarks/discrepancy_hatton.py --out hatton-run
+    .venv/bin/python -m benchmarks.studies.discrepancy_hatton --out hatton-run
 
 Needs ../shared/refdata/hatton_granular_three_link_connection.mat (or --table).
 """

@@ -3,13 +3,13 @@
 Usage::
 
     # read a campaign already run
-    .venv/bin/python benchmarks/findings.py --db demo.duckdb --campaign paper
+    .venv/bin/python -m benchmarks.studies.findings --db demo.duckdb --campaign paper
     # on fresh simulated datasets, one database per dataset seed, at the paper's scale
-    .venv/bin/python benchmarks/findings.py --seeds 0,1,2 --out bench-findings --jobs 2
+    .venv/bin/python -m benchmarks.studies.findings --seeds 0,1,2 --out bench-findings --jobs 2
     # a quick look at a reduced scale
-    .venv/bin/python benchmarks/findings.py --seeds 0 --boots 2 --sweep 1-3,30
+    .venv/bin/python -m benchmarks.studies.findings --seeds 0 --boots 2 --sweep 1-3,30
     # another robot: a simulator config file, effects over it
-    .venv/bin/python benchmarks/findings.py --seeds 0 --config examples/calibrated_robot.toml
+    .venv/bin/python -m benchmarks.studies.findings --seeds 0 --config examples/calibrated_robot.toml
 
 For each dataset seed (``--seeds``): simulate the paper's design with the default
 simulator (`simulate_dataset`; the robot of ``--config`` with the effects of ``--set``),
@@ -34,18 +34,16 @@ from pathlib import Path
 
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.analysis.findings import (  # noqa: E402
+from suds_exp.analysis.findings import (
     findings,
     findings_display,
     findings_headline,
     findings_summary,
 )
-from suds_exp.analysis.formatting import to_markdown  # noqa: E402
-from suds_exp.campaign import run_campaign  # noqa: E402
-from suds_exp.commands.campaign import parse_campaign_options  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.analysis.formatting import to_markdown
+from suds_exp.campaign import run_campaign
+from suds_exp.commands.campaign import parse_campaign_options
+from suds_exp.store import Store
 
 
 def prepare(db: Path, seed: int, effects: list[str] = (), config: Path | None = None) -> str:

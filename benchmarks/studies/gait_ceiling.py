@@ -9,27 +9,23 @@ projected into the bound by `within_bound`, as the designer's are), and prints t
 gait, its displacement and the paper's five for scale. No learned map, no trust region: the
 number `gait design` is compared with.
 
-Run: .venv/bin/python benchmarks/gait_ceiling.py [--bound 1.3] [--order 2] [--evals 300]
+Run: .venv/bin/python -m benchmarks.studies.gait_ceiling [--bound 1.3] [--order 2] [--evals 300]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import minimize
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.gait.design import circle  # noqa: E402
-from suds_exp.gait.shape import FourierGait, paper_gaits, within_bound  # noqa: E402
-from suds_exp.gait.truth import simulate_forward  # noqa: E402
+from suds_exp.gait.design import circle
+from suds_exp.gait.shape import FourierGait, paper_gaits, within_bound
+from suds_exp.gait.truth import simulate_forward
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
     ap.add_argument("--order", type=int, default=2, help="Fourier harmonics per joint")
@@ -38,7 +34,10 @@ def main() -> None:
     ap.add_argument("--starts", type=int, default=3, help="local searches from the best")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--freq", type=float, default=0.5, help="Hz")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.order, args.evals, args.random, args.starts = 1, 5, 3, 1
     started = time.perf_counter()
     paper = simulate_forward(paper_gaits(), args.freq)
     n_sims = 0

@@ -16,31 +16,29 @@ Why the extra gaits: the paper's five gaits all circle the origin in one sense, 
 shape the data hold one direction of shape velocity (the five cross at shallow angles);
 the second column of A is then an extrapolation of the learner, not a measurement.
 
-Run: .venv/bin/python benchmarks/gait_connection.py [--extra] [--out reports/gait-connection]
+Run: .venv/bin/python -m benchmarks.studies.gait_connection [--extra] [--out reports/gait-connection]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.gait.connection import compare_connections, learned_connection  # noqa: E402
-from suds_exp.gait.plots import draw_connection  # noqa: E402
-from suds_exp.gait.predict import decimate, fit_map  # noqa: E402
-from suds_exp.gait.shape import TWO_PI, SampledGait, ellipse, paper_gaits  # noqa: E402
-from suds_exp.gait.trials import simulate_gait_file  # noqa: E402
-from suds_exp.ingest import ingest_paths  # noqa: E402
-from suds_exp.preprocess import get_version, preprocess  # noqa: E402
-from suds_exp.sim import SimConfig, local_connection, set_effect, simulate_dataset  # noqa: E402
-from suds_exp.sim.connection import body_twists, robot_config  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from benchmarks._data import QUICK_DESIGN
+from suds_exp.gait.connection import compare_connections, learned_connection
+from suds_exp.gait.plots import draw_connection
+from suds_exp.gait.predict import decimate, fit_map
+from suds_exp.gait.shape import TWO_PI, SampledGait, ellipse, paper_gaits
+from suds_exp.gait.trials import simulate_gait_file
+from suds_exp.ingest import ingest_paths
+from suds_exp.preprocess import get_version, preprocess
+from suds_exp.sim import SimConfig, local_connection, set_effect, simulate_dataset
+from suds_exp.sim.connection import body_twists, robot_config
+from suds_exp.store import Store
 
 
 def flower(petals: int, name: str) -> SampledGait:
@@ -93,18 +91,23 @@ def at_data_directions(model, samples, n: int = 2000, seed: int = 0) -> np.ndarr
     return np.sqrt(((learned - sim) ** 2).mean(0)) / np.sqrt((sim**2).mean(0))
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--extra", action="store_true", help="add the extra gaits")
     ap.add_argument("--grid", type=int, default=41)
     ap.add_argument("--range", type=float, default=2.0, dest="half_range")
     ap.add_argument("--out", type=Path, default=Path("reports/gait-connection"))
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
+    design = {}
+    if args.quick:
+        args.extra, args.grid, design = False, 9, QUICK_DESIGN
+        args.out = Path(tempfile.mkdtemp(prefix="suds-gait-conn-quick-"))
     started = time.perf_counter()
     cfg = set_effect(SimConfig(), "flippers=locked")
     with tempfile.TemporaryDirectory(prefix="suds-gait-conn-") as tmp:
         store = Store(Path(tmp) / "locked.duckdb")
-        ds = simulate_dataset(Path(tmp) / "paper", cfg)
+        ds = simulate_dataset(Path(tmp) / "paper", cfg, **design)
         ingest_paths(store, [], ds.manifest, progress=False)
         if args.extra:
             for g in extra_gaits():

@@ -19,13 +19,12 @@ cycle-to-cycle spread (max - min over cycles 3-5), the median relative error and
 Spearman's rank correlation per set, and with --boot N both figures over N refits on
 training trials resampled with replacement (median and 2.5-97.5 percentiles).
 
-Run: .venv/bin/python benchmarks/gait_predict.py [--learner GMR] [--seed 0] [--boot 0]
+Run: .venv/bin/python -m benchmarks.studies.gait_predict [--learner GMR] [--seed 0] [--boot 0]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -33,18 +32,19 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import spearmanr
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.gait.predict import bootstrap_draws, decimate, fit_map  # noqa: E402
-from suds_exp.gait.shape import paper_gaits  # noqa: E402
-from suds_exp.gait.support import Support  # noqa: E402
-from suds_exp.gait.testing import (  # noqa: E402
+from benchmarks._data import QUICK_DESIGN, simulated_database
+from suds_exp.gait.predict import bootstrap_draws, decimate, fit_map
+from suds_exp.gait.shape import paper_gaits
+from suds_exp.gait.support import Support
+from suds_exp.gait.testing import (
     INSIDE_CANDIDATES,
     UNSEEN,
     default_dataset_samples,
     inside_support,
 )
-from suds_exp.gait.truth import simulate_gaits  # noqa: E402
+from suds_exp.gait.truth import simulate_gaits
+from suds_exp.preprocess import get_version
+from suds_exp.store import Store
 
 
 def scores(pred: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
@@ -52,15 +52,21 @@ def scores(pred: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
     return float(np.median(np.abs(pred - truth) / np.abs(truth))), float(spearmanr(pred, truth)[0])
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--learner", default="GMR")
     ap.add_argument("--seed", type=int, default=0, help="dataset seed")
     ap.add_argument("--boot", type=int, default=0, help="refits on resampled trials")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
     started, cpu = time.perf_counter(), time.process_time()
     with tempfile.TemporaryDirectory(prefix="suds-gait-predict-") as tmp:
-        samples = default_dataset_samples(Path(tmp), args.seed)
+        if args.quick:
+            db = Path(tmp) / "quick.duckdb"
+            name = simulated_database(db, QUICK_DESIGN, args.seed)
+            samples = get_version(Store(db), name).samples()
+        else:
+            samples = default_dataset_samples(Path(tmp), args.seed)
     support = Support.of(decimate(samples))
     inside = inside_support(INSIDE_CANDIDATES(), support)
     sets = {"paper's five (training)": paper_gaits(), "UNSEEN": UNSEEN(), "inside support": inside}

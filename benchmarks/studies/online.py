@@ -3,7 +3,7 @@ and the cost of one partial_fit against the cycle it learns.
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/online.py [--seeds 20]
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.online [--seeds 20]
         [--change flippers=locked@30s] [--cycles 60] [--freq 1] [--models GMR,OnlineGMR]
 
 Data: the physics simulator, gait O at `--freq` Hz, `--cycles` cycles a trial, one trial

@@ -16,24 +16,23 @@ so the order where phase-only's held-out error stops falling, and whether TLS im
 its own constant term, can be read off.
 
     make demo     # or any database with the default dataset preprocessed as v1
-    .venv/bin/python benchmarks/phase_only.py --db suds.duckdb --prep v1 --orders 5,6,8,10,12
+    .venv/bin/python -m benchmarks.studies.phase_only --db suds.duckdb --prep v1 --orders 5,6,8,10,12
 """
 
 from __future__ import annotations
 
 import argparse
 import itertools
-import sys
+import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+import pandas as pd
 
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from suds_exp.models import make_model  # noqa: E402
-from suds_exp.preprocess import get_version  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from benchmarks._data import QUICK_DESIGN, simulated_database
+from suds_exp.models import make_model
+from suds_exp.preprocess import get_version
+from suds_exp.store import Store
 
 TRAIN_CYCLES = 30
 
@@ -69,12 +68,23 @@ def compare(samples: pd.DataFrame, orders: list[int]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def main() -> None:
+def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--db", default="suds.duckdb")
     p.add_argument("--prep", default="v1")
     p.add_argument("--orders", default="5,6,8,10,12", help="Fourier orders, comma list")
-    args = p.parse_args()
+    p.add_argument("--quick", action="store_true", help="a smoke run on a tiny simulated dataset")
+    args = p.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-phase-only-") as tmp:
+            db = Path(tmp) / "quick.duckdb"
+            args.db, args.prep, args.orders = db, simulated_database(db, QUICK_DESIGN), "5"
+            report(args)
+        return
+    report(args)
+
+
+def report(args) -> None:
     store = Store(args.db)
     samples = get_version(store, args.prep).samples()
     if "gait" not in samples:

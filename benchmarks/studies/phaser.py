@@ -3,7 +3,7 @@ both trained on 3 trials and applied to 3 others whose true phase is known.
 
 Usage::
 
-    .venv/bin/python benchmarks/phaser.py [--json] [--seed 0]
+    .venv/bin/python -m benchmarks.studies.phaser [--json] [--seed 0]
 
 Cases (each: error to truth of both estimators, and their ratio ours / reference):
 
@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import tempfile
 import warnings
 from pathlib import Path
@@ -41,12 +40,10 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.commands.simulate import simulate_command  # noqa: E402
-from suds_exp.preprocess import Phaser, load_samples, preprocess  # noqa: E402
-from suds_exp.preprocess.truth import truth_path  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.commands.simulate import simulate_command
+from suds_exp.preprocess import Phaser, load_samples, preprocess
+from suds_exp.preprocess.truth import truth_path
+from suds_exp.store import Store
 
 ORDER = 10
 TWO_PI = 2 * np.pi
@@ -171,15 +168,17 @@ def relaxation_cases(seed: int) -> dict[str, dict]:
     return out
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--reference", help="Python file defining ReferencePhaser (see above)")
-    args = parser.parse_args()
+    parser.add_argument("--quick", action="store_true", help="a smoke run: the 1 Hz trials")
+    args = parser.parse_args(argv)
     global REFERENCE
     REFERENCE = load_reference(args.reference) if args.reference else None
-    cases = {**gait_cases(args.seed), **relaxation_cases(args.seed)}
+    freqs = (1.0,) if args.quick else (1 / 3, 0.5, 1.0)
+    cases = {**gait_cases(args.seed, freqs), **relaxation_cases(args.seed)}
     if args.json:
         print(json.dumps(cases, indent=1))
         return

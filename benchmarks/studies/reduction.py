@@ -2,7 +2,7 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python benchmarks/reduction.py --db survey.duckdb \
+    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python -m benchmarks.studies.reduction --db survey.duckdb \
         [--reductions pca,kernel-pca,autoencoder] [--models TLS+SUDS,GMR+SUDS,GMR] \
         [--conditions O@0.5,D+@0.5,S-@1] [--boots 4] [--jobs 2]
 
@@ -23,20 +23,17 @@ from __future__ import annotations
 
 import argparse
 import shutil
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.analysis.queries import load_results  # noqa: E402
-from suds_exp.campaign import run_campaign  # noqa: E402
-from suds_exp.commands.campaign import parse_campaign_options  # noqa: E402
-from suds_exp.preprocess import preprocess  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.analysis.queries import load_results
+from suds_exp.campaign import run_campaign
+from suds_exp.commands.campaign import parse_campaign_options
+from suds_exp.preprocess import preprocess
+from suds_exp.store import Store
 
 KEY = ["train_gait", "train_frequency_hz", "test_gait", "test_frequency_hz", "boot"]
 

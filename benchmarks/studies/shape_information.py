@@ -23,10 +23,10 @@ setting with the median over the 15 conditions. ``--springs`` repeats everything
 stiffness of the flippers' tape hinges (N mm/rad, `Hinges.spring_n_mm_per_rad`), on the
 robot of ``--config`` (default nominal) with the effects of ``--set``.
 
-    .venv/bin/python benchmarks/shape_information.py
-    .venv/bin/python benchmarks/shape_information.py --gait O --freqs 1/3,1 \\
+    .venv/bin/python -m benchmarks.studies.shape_information
+    .venv/bin/python -m benchmarks.studies.shape_information --gait O --freqs 1/3,1 \\
         --set servo.compliance_rad_per_n_m=0.11 servo.stall_torque_n_m=2.5 bed_packing.trial_cv=0.25
-    .venv/bin/python benchmarks/shape_information.py --pipeline \\
+    .venv/bin/python -m benchmarks.studies.shape_information --pipeline \\
         --config examples/calibrated_robot.toml --springs 5,20,50,100,200,300
 """
 
@@ -34,19 +34,16 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import sys
 import tempfile
 from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.ingest import ingest_paths  # noqa: E402
-from suds_exp.models import fourier  # noqa: E402
-from suds_exp.preprocess import get_version, preprocess  # noqa: E402
-from suds_exp.sim import (  # noqa: E402
+from suds_exp.ingest import ingest_paths
+from suds_exp.models import fourier
+from suds_exp.preprocess import get_version, preprocess
+from suds_exp.sim import (
     SimConfig,
     apply_effects,
     config_from_dict,
@@ -55,7 +52,7 @@ from suds_exp.sim import (  # noqa: E402
     simulate_dataset,
     simulate_trials,
 )
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.store import Store
 
 
 def basis(phase: np.ndarray, order: int, x: np.ndarray | None = None) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python benchmarks/survey.py \
+    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python -m benchmarks.studies.survey \
         [--db survey.duckdb] [--gaits O] [--boots 4] [--sweep 1,2,4,8,16,30,48] [--jobs 2] \
         [--campaign survey] [--models survey] [--conditions O@0.5]
 
@@ -41,22 +41,20 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+import pandas as pd
 
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from suds_exp.analysis.queries import load_results  # noqa: E402
-from suds_exp.analysis.survey import (  # noqa: E402
+from suds_exp.analysis.queries import load_results
+from suds_exp.analysis.survey import (
     SURVEY_COLUMNS,
     efficiency_ratio,
     ratio_sentence,
     survey_from_results,
 )
-from suds_exp.campaign import run_campaign  # noqa: E402
-from suds_exp.commands.campaign import parse_campaign_options  # noqa: E402
-from suds_exp.models.registry import LEARNERS  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.campaign import run_campaign
+from suds_exp.commands.campaign import parse_campaign_options
+from suds_exp.models.registry import LEARNERS
+from suds_exp.store import Store
 
 
 def ensure_data(store: Store, gaits: list[str]) -> None:

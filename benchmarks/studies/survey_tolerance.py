@@ -2,7 +2,7 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python benchmarks/survey_tolerance.py \
+    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python -m benchmarks.studies.survey_tolerance \
         [--db tolerance.duckdb] [--gaits O] [--conditions O@0.5,O@1] [--boots 3] \
         [--sweep 1,2,4,8,16,30,48] [--seeds 5] [--recipes all] [--rows rows.csv] [--jobs 1]
 
@@ -41,7 +41,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-import pandas as pd  # noqa: E402
+import pandas as pd
 
 #: The survey's recipe before session 15 ("old"), every setting a candidate changes
 #: pinned, so the reference does not move with the defaults; candidates change it.
