@@ -44,7 +44,7 @@ def noisy(samples: pd.DataFrame, seed: int) -> pd.DataFrame:
     return out
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--change", default="flippers=locked@30s")
@@ -52,7 +52,10 @@ def main() -> None:
     ap.add_argument("--freq", type=float, default=1.0)
     ap.add_argument("--models", default="GMR,OnlineGMR,GMR+SUDS,OnlineGMR+SUDS")
     ap.add_argument("--json", action="store_true", help="also print the summary as JSON")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.seeds, args.cycles, args.models = 1, 40, "GMR,OnlineGMR"
     change = parse_change(args.change)
     models = [m.strip() for m in args.models.split(",") if m.strip()]
     start = time.perf_counter()

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks._data import QUICK_DESIGN, simulated_database
 from suds_exp.analysis.queries import load_results
 from suds_exp.campaign import run_campaign
 from suds_exp.commands.campaign import parse_campaign_options
@@ -54,15 +55,31 @@ def paired_ratio(a: np.ndarray, b: np.ndarray, n_boot: int = 2000, seed: int = 0
     return float(np.median(r)), *np.quantile(meds, [0.025, 0.975])
 
 
-def main() -> None:
+def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--db", required=True)
+    p.add_argument("--db", help="a database with the dataset (required unless --quick)")
     p.add_argument("--reductions", default="pca,kernel-pca,autoencoder")
     p.add_argument("--models", default="TLS+SUDS,GMR+SUDS,GMR")
     p.add_argument("--conditions", default="O@0.5,D+@0.5,S-@1")
     p.add_argument("--boots", type=int, default=4)
     p.add_argument("--jobs", type=int, default=2)
-    args = p.parse_args()
+    p.add_argument("--train-cycles", type=int, default=30)
+    p.add_argument("--quick", action="store_true", help="a smoke run on a tiny simulated dataset")
+    args = p.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-reduction-") as tmp:
+            args.db = Path(tmp) / "quick.duckdb"
+            simulated_database(args.db, QUICK_DESIGN)
+            args.reductions, args.models, args.conditions = "pca", "TLS+SUDS", "O@0.5,D+@1"
+            args.boots, args.jobs, args.train_cycles = 1, 1, 2
+            study(args)
+        return
+    if args.db is None:
+        p.error("--db is required (or --quick)")
+    study(args)
+
+
+def study(args) -> None:
     store = Store(args.db)
     reductions = args.reductions.split(",")
     versions = {r: ensure_version(store, r) for r in reductions}
@@ -75,7 +92,7 @@ def main() -> None:
                 prep=version,
                 models=args.models,
                 boots=args.boots,
-                train_cycles=30,
+                train_cycles=args.train_cycles,
                 train_conditions=args.conditions,
                 test_conditions=args.conditions,
             )

@@ -136,7 +136,7 @@ def pipeline(cfg: SimConfig, seed: int, order: int) -> dict[str, float]:
     return {key: float(np.median([c[key] for c in per_condition])) for key in per_condition[0]}
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--gait", default="O")
     ap.add_argument("--freqs", default="1/3,1", help="Hz, comma list (fractions allowed)")
@@ -153,7 +153,10 @@ def main() -> None:
     ap.add_argument("--set", nargs="*", default=[], help="effects, EFFECT.PARAM=VALUE")
     ap.add_argument("--springs", default="", help="hinge springs to sweep, N mm/rad")
     ap.add_argument("--pipeline", action="store_true", help="the whole design, preprocessed")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.freqs, args.repeats, args.pipeline, args.springs = "1", 2, False, ""
     base = load_config(args.config) if args.config else SimConfig()
     base = apply_effects(base, args.set, param="--set")
     springs = [float(k) for k in args.springs.split(",") if k] or [base.hinges.spring_n_mm_per_rad]
