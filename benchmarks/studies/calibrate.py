@@ -46,6 +46,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks._data import QUICK_DESIGN
+from benchmarks._harness import ROOT
 from suds_exp.analysis.findings import findings
 from suds_exp.campaign import CampaignOptions, run_campaign
 from suds_exp.ingest import ingest_paths
@@ -81,7 +83,7 @@ SEARCH_SPACE = {
     "hinge_friction.torque_n_mm": (0.0, 30.0),
 }
 #: The calibrated setting's one home: the example configuration users load with --config.
-CALIBRATED = Path(__file__).resolve().parents[1] / "examples" / "calibrated_robot.toml"
+CALIBRATED = ROOT / "examples" / "calibrated_robot.toml"
 
 
 def effect_items(path: Path) -> list[str]:
@@ -158,14 +160,14 @@ def run_setting(name: str, items: list[str], args, spring: float | None = None) 
         cfg = config_from_dict({"hinges": {"spring_n_mm_per_rad": spring}}, base=cfg)
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="suds-calibrate-") as tmp:
-        ds = simulate_dataset(Path(tmp) / "data", cfg, seed=args.seed)
+        ds = simulate_dataset(Path(tmp) / "data", cfg, seed=args.seed, **args.design)
         store = Store(Path(tmp) / "calib.duckdb")
         ingest_paths(store, [Path(tmp) / "data"], ds.manifest, None, progress=False)
         prep = preprocess(store, progress=False).name
         opts = CampaignOptions(
             prep=prep,
             boots=args.boots,
-            train_cycles=30,
+            train_cycles=args.train_cycles,
             sweep=[int(c) for c in args.sweep.split(",")],
             skip_infeasible=True,
         )
@@ -201,7 +203,7 @@ def summary(table: pd.DataFrame) -> str:
     return out.sort_values(["side", "hold"], ascending=False).to_string(index=False)
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--settings", default="", help="named settings: " + ", ".join(NAMED))
     ap.add_argument("--search", type=int, default=0, help="draw this many settings")
@@ -215,7 +217,20 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("bench-calibrate.csv"))
     ap.add_argument("--springs", default="", help="hinge springs, N mm/rad (default nominal)")
-    args = ap.parse_args()
+    ap.add_argument("--train-cycles", type=int, default=30)
+    ap.add_argument("--quick", action="store_true", help="a smoke run on a tiny design")
+    args = ap.parse_args(argv)
+    args.design = {}
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-calibrate-quick-") as tmp:
+            args.settings, args.boots, args.sweep, args.n_boot, args.jobs = "nominal", 1, "2", 20, 1
+            args.train_cycles, args.design, args.out = 2, QUICK_DESIGN, Path(tmp) / "quick.csv"
+            study(args)
+        return
+    study(args)
+
+
+def study(args) -> None:
     check_space()
     plan: dict[str, list[str]] = {}
     for name in [n for n in args.settings.split(",") if n]:

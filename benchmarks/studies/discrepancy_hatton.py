@@ -28,13 +28,14 @@ import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 from scipy.io import loadmat
 
+from benchmarks._harness import ROOT
 from suds_exp.discrepancy import DiscrepancyOptions, run_discrepancy
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.dataset import plan_trials, simulate_trials, truth_markers
 from suds_exp.sim.files import write_manifest, write_qtm_tsv
 from suds_exp.sim.markers import MARKER_NAMES, measure
 
-TABLE = Path(__file__).resolve().parents[1] / ".." / "shared" / "refdata"
+TABLE = ROOT / ".." / "shared" / "refdata"
 TABLE = TABLE / "hatton_granular_three_link_connection.mat"
 #: The notes' probable relabelling of the table's grid (true angle = label x 1.142).
 GRID_SCALE = 1.142

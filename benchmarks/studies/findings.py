@@ -67,7 +67,7 @@ def prepare(db: Path, seed: int, effects: list[str] = (), config: Path | None = 
     return preprocess(store, progress=False).name
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--db", type=Path, help="read --campaign from this database")
     parser.add_argument("--seeds", help="dataset seeds to simulate, e.g. 0,1,2")
@@ -88,9 +88,32 @@ def main() -> None:
     parser.add_argument(
         "--config", type=Path, help="simulator config file of the robot (default nominal)"
     )
-    args = parser.parse_args()
+    parser.add_argument(
+        "--quick", action="store_true", help="a smoke run: the table of 2 synthetic draws a pair"
+    )
+    args = parser.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-findings-quick-") as tmp:
+            args.db, args.boot = Path(tmp) / "quick.duckdb", 20
+            _synthetic_campaign(args.db, args.campaign)
+            study(args)
+        return
     if (args.db is None) == (args.seeds is None):
         parser.error("give exactly one of --db (read a campaign) or --seeds (simulate and run)")
+    study(args)
+
+
+def _synthetic_campaign(db: Path, campaign: str) -> None:
+    """A database whose ``results`` hold a synthetic campaign (2 draws a pair)."""
+    from suds_exp.testing.synthetic_results import synthetic_results
+
+    store = Store(db)
+    store.upgrade()
+    with store.write() as conn:
+        store.insert_df(conn, "results", synthetic_results(campaign, n_boot=2))
+
+
+def study(args) -> None:
 
     tables: dict[str, pd.DataFrame] = {}
     if args.db is not None:
