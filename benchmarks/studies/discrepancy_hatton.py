@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import json
+import tempfile
 import time
 from pathlib import Path
 
@@ -40,6 +41,8 @@ TABLE = TABLE / "hatton_granular_three_link_connection.mat"
 #: The notes' probable relabelling of the table's grid (true angle = label x 1.142).
 GRID_SCALE = 1.142
 DESIGN = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
+#: ``--quick``'s design (a smoke run).
+QUICK_DESIGN = dict(gaits=("O", "D+"), frequencies_hz=(0.5, 1.0), repeats=2, cycles=(3, 3))
 
 
 def connection(path: Path):
@@ -73,7 +76,7 @@ def hatton_truth(truth: dict, T, link_mm: float) -> dict:
     return out
 
 
-def make_dataset(work: Path, table: Path, seed: int):
+def make_dataset(work: Path, table: Path, seed: int, design: dict = DESIGN):
     """Write the Hatton-driven capture files, ingest and preprocess them; return the store."""
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
@@ -84,7 +87,7 @@ def make_dataset(work: Path, table: Path, seed: int):
     data.mkdir(parents=True, exist_ok=True)
     T = connection(table)
     specs = plan_trials(
-        DESIGN["gaits"], DESIGN["frequencies_hz"], DESIGN["repeats"], DESIGN["cycles"], seed
+        design["gaits"], design["frequencies_hz"], design["repeats"], design["cycles"], seed
     )
     rows = []
     for spec, truth in zip(specs, simulate_trials(specs, cfg), strict=True):
@@ -115,22 +118,32 @@ def make_dataset(work: Path, table: Path, seed: int):
     return store
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("hatton-run"))
     ap.add_argument("--table", type=Path, default=TABLE)
     ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run on a tiny design")
+    args = ap.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-hatton-quick-") as tmp:
+            args.out = Path(tmp)
+            study(args, QUICK_DESIGN, {"max_effects": 1, "refine": False, "discover": False})
+        return
+    study(args)
+
+
+def study(args, design: dict = DESIGN, options: dict | None = None) -> None:
     started = time.perf_counter()
-    store = make_dataset(args.out, args.table, args.seed)
+    store = make_dataset(args.out, args.table, args.seed, design)
     res = run_discrepancy(
         store,
         "v1",
         SimConfig(),
         name="hatton",
-        options=DiscrepancyOptions(seed=args.seed),
+        options=DiscrepancyOptions(seed=args.seed, **(options or {})),
         out=args.out / "report",
-        progress=True,
+        progress=not args.quick,
     )
     doc = res.to_dict()
     summary = {
