@@ -38,6 +38,8 @@ Rows are appended to --out as runs finish, so an interrupted benchmark keeps its
 from __future__ import annotations
 
 import argparse
+import functools
+import tempfile
 import time
 from pathlib import Path
 
@@ -48,13 +50,15 @@ from suds_exp.robot import GAITS
 from suds_exp.workflows.hidden_effects import HIDDEN, draw_hidden, hidden_effect_run
 
 DESIGN = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
+#: ``--quick``'s design (a smoke run).
+QUICK_DESIGN = dict(gaits=("O", "D+"), frequencies_hz=(0.5, 1.0), repeats=2, cycles=(3, 3))
 
 
-def one_run(effect: str | None, seed: int) -> dict:
+def one_run(effect: str | None, seed: int, design: dict = DESIGN) -> dict:
     rng = np.random.default_rng(seed)
     hidden = {} if effect is None else {effect: draw_hidden(effect, rng)}
     started = time.perf_counter()
-    run = hidden_effect_run(hidden, seed=seed, **DESIGN)
+    run = hidden_effect_run(hidden, seed=seed, **design)
     res = run.result
     # an effect found partial (its strength not constant) is not named as the cause
     named = [n for n in res.named if n.get("role", "cause") == "cause"]
@@ -280,7 +284,7 @@ def run_plan(plan, out: Path, key: str, run) -> pd.DataFrame:
     return pd.read_csv(out)
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3, help="seeds per hidden effect")
     ap.add_argument("--first-seed", type=int, default=0, help="start at seed 100 + this")
@@ -312,7 +316,14 @@ def main() -> None:
     ap.add_argument("--detection", metavar="EFFECT", help="detection limit of this effect")
     ap.add_argument("--values", help="with --detection: parameter values, comma-separated")
     ap.add_argument("--detection-seeds", default="11,12,13", help="with --detection")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run: one small hidden run")
+    args = ap.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-discrepancy-quick-") as tmp:
+            quick_run = functools.partial(one_run, design=QUICK_DESIGN)
+            table = run_plan([("body_inertia", 100)], Path(tmp) / "quick.csv", "hidden", quick_run)
+        print(f"workflow time {table['workflow_seconds'].median():.1f} s")
+        return
     if args.detection:
         if args.detection not in HIDDEN:
             ap.error(f"--detection {args.detection}: expected one of {', '.join(sorted(HIDDEN))}")
