@@ -99,7 +99,7 @@ def decimated(store: Store, prep: str) -> pd.DataFrame:
     return frame[index % step.reindex(frame["trial_id"]).to_numpy() == 0]
 
 
-def main() -> None:
+def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--db", default="survey.duckdb")
     p.add_argument("--gaits", default="S+,S-,O,D-,D+")
@@ -113,7 +113,19 @@ def main() -> None:
     p.add_argument("--per-condition", action="store_true")
     p.add_argument("--skip-infeasible", action="store_true")
     p.add_argument("--prep", default="v1")
-    args = p.parse_args()
+    p.add_argument("--quick", action="store_true", help="a smoke run: O at 1 Hz, 4 learners")
+    args = p.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-survey-quick-") as tmp:
+            args.db, args.gaits, args.conditions = str(Path(tmp) / "quick.duckdb"), "O", "O@1"
+            args.models, args.sweep, args.boots = "phase-only,TLS,GMR,MLP", "2,30", 2
+            args.n_boot, args.jobs, args.per_condition = 50, 1, False
+            study(args)
+        return
+    study(args)
+
+
+def study(args) -> None:
     store = Store(args.db)
     ensure_data(store, args.gaits.split(","))
     samples = None
