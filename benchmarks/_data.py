@@ -12,6 +12,7 @@ commit comparison's worker imports this module beside the baseline's `suds_exp`.
 
 from __future__ import annotations
 
+import tempfile
 import time
 from pathlib import Path
 
@@ -145,8 +146,6 @@ def simulated_database(db: Path, design: dict | None = None, seed: int = 0, conf
     """Simulate ``design`` (keywords of `simulate_dataset`; default the paper's) with the
     robot ``config`` (default nominal), ingest it into the new database ``db`` and
     preprocess it with the defaults; returns the preprocessing version's name."""
-    import tempfile
-
     from suds_exp.ingest import ingest_paths
     from suds_exp.preprocess import preprocess
     from suds_exp.sim import simulate_dataset
@@ -158,3 +157,37 @@ def simulated_database(db: Path, design: dict | None = None, seed: int = 0, conf
         data = simulate_dataset(tmp, config, seed=seed, **(design or {}))
         ingest_paths(store, [Path(tmp)], manifest=data.manifest, progress=False)
     return preprocess(store, progress=False).name
+
+
+def ensure_data(store, gaits: list[str]) -> None:
+    """The survey studies' data: the default design's ``gaits`` simulated, ingested and
+    preprocessed as ``v1`` in ``store``, each step when the database does not hold it yet."""
+    from suds_exp.ingest import ingest_paths, list_trials
+    from suds_exp.preprocess import list_versions, preprocess
+    from suds_exp.sim.dataset import simulate_dataset
+
+    store.upgrade()
+    if list_trials(store).empty:
+        with tempfile.TemporaryDirectory() as folder:
+            sim = simulate_dataset(folder, gaits=gaits)
+            ingest_paths(store, [Path(folder)], sim.manifest, None, progress=False)
+    if "v1" not in list_versions(store)["name"].astype(str).tolist():
+        preprocess(store, name="v1", progress=False)
+
+
+def decimated(store, prep: str) -> pd.DataFrame:
+    """The version's samples, every trial decimated (plain, from its first sample) to the
+    smallest samples per cycle of the whole dataset, as `campaign.bank` does for a grid
+    over every condition."""
+    import numpy as np
+
+    from suds_exp.preprocess import get_version
+
+    frame = get_version(store, prep).samples().sort_values(["trial_id", "t"])
+    per_trial = frame.groupby("trial_id").agg(
+        dt=("t", lambda t: float(np.median(np.diff(t.to_numpy())))), hz=("frequency_hz", "first")
+    )
+    spc = 1.0 / (per_trial["dt"] * per_trial["hz"])
+    step = (spc / round(float(spc.min()))).round().clip(lower=1).astype(int)
+    index = frame.groupby("trial_id").cumcount().to_numpy()
+    return frame[index % step.reindex(frame["trial_id"]).to_numpy() == 0]

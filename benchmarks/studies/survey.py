@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks._data import decimated, ensure_data
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.survey import (
     SURVEY_COLUMNS,
@@ -57,21 +58,6 @@ from suds_exp.models.registry import LEARNERS
 from suds_exp.store import Store
 
 
-def ensure_data(store: Store, gaits: list[str]) -> None:
-    """Simulate, ingest and preprocess when the database has no samples yet."""
-    from suds_exp.ingest import ingest_paths, list_trials
-    from suds_exp.preprocess import list_versions, preprocess
-    from suds_exp.sim.dataset import simulate_dataset
-
-    store.upgrade()
-    if list_trials(store).empty:
-        with tempfile.TemporaryDirectory() as folder:
-            sim = simulate_dataset(folder, gaits=gaits)
-            ingest_paths(store, [Path(folder)], sim.manifest, None, progress=False)
-    if "v1" not in list_versions(store)["name"].astype(str).tolist():
-        preprocess(store, name="v1", progress=False)
-
-
 def all_conditions(store: Store, spec: str | None = None) -> list[str]:
     """The stored trials' conditions named by ``spec`` (None: all), as GAIT@FREQ in one
     spelling (``O@1/3`` and ``O@0.333333`` name the same campaign)."""
@@ -81,22 +67,6 @@ def all_conditions(store: Store, spec: str | None = None) -> list[str]:
     t = list_trials(store)[["gait", "frequency_hz"]].drop_duplicates()
     have = [(g, round(float(f), 6)) for g, f in t.itertuples(index=False, name=None)]
     return [format_condition(c) for c in select_conditions(spec, have, "--conditions")]
-
-
-def decimated(store: Store, prep: str) -> pd.DataFrame:
-    """The version's samples, every trial decimated (plain, from its first sample) to the
-    smallest samples per cycle of the whole dataset, as `campaign.bank` does for a grid
-    over every condition."""
-    from suds_exp.preprocess import get_version
-
-    frame = get_version(store, prep).samples().sort_values(["trial_id", "t"])
-    per_trial = frame.groupby("trial_id").agg(
-        dt=("t", lambda t: float(np.median(np.diff(t.to_numpy())))), hz=("frequency_hz", "first")
-    )
-    spc = 1.0 / (per_trial["dt"] * per_trial["hz"])
-    step = (spc / round(float(spc.min()))).round().clip(lower=1).astype(int)
-    index = frame.groupby("trial_id").cumcount().to_numpy()
-    return frame[index % step.reindex(frame["trial_id"]).to_numpy() == 0]
 
 
 def main(argv=None) -> None:

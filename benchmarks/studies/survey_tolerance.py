@@ -10,7 +10,7 @@ Protocol (docs/results/speed.md, "Session 15: the survey's baselines"):
 
 1. Draws: the same-condition sweep of ``--conditions`` (train = test condition, every size
    of ``--sweep``, ``--boots`` draws each), made exactly as a per-condition survey
-   campaign makes them (`benchmarks/survey.py --per-condition`: the default simulated
+   campaign makes them (`benchmarks.studies.survey --per-condition`: the default simulated
    dataset's ``--gaits``, preprocessed as ``v1``, decimated to the whole dataset's samples
    per cycle; a draw's seed is its key's hash).
 2. Seeds: seed 0 of a learner on a draw is the campaign's own (`Draw.model_seed(name)`);
@@ -33,15 +33,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
 import pandas as pd
+
+from benchmarks._data import decimated, ensure_data
 
 #: The survey's recipe before session 15 ("old"), every setting a candidate changes
 #: pinned, so the reference does not move with the defaults; candidates change it.
@@ -147,14 +146,13 @@ def _task(learner: str, label: str, params: dict, seed: int) -> list[dict]:
 def load_samples(db: str, gaits: list[str], spec: str):
     """The default dataset's ``gaits`` (simulated into ``db`` if empty), decimated as a
     per-condition survey does it, and the conditions of ``spec``."""
-    from benchmarks import survey as sv
     from suds_exp.campaign.bank import rounded_conditions
     from suds_exp.campaign.conditions import select_conditions
     from suds_exp.store import Store
 
     store = Store(db)
-    sv.ensure_data(store, gaits)
-    samples = sv.decimated(store, "v1")
+    ensure_data(store, gaits)
+    samples = decimated(store, "v1")
     conditions = select_conditions(spec, rounded_conditions(samples), "--conditions")
     return samples, conditions
 
@@ -237,7 +235,18 @@ def main(argv=None) -> int:
     ap.add_argument("--rows", default="tolerance_rows.csv")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--n-boot", type=int, default=1000)
+    ap.add_argument("--quick", action="store_true", help="a smoke run: O at 1 Hz, GMR and MLP")
     a = ap.parse_args(argv)
+    if a.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-tolerance-quick-") as tmp:
+            a.db, a.rows = str(Path(tmp) / "quick.duckdb"), str(Path(tmp) / "rows.csv")
+            a.gaits, a.conditions, a.boots, a.sweep, a.seeds = "O", "O@1", 1, "2,30", 2
+            a.recipes, a.only, a.jobs, a.n_boot = "old", "GMR,MLP", 1, 50
+            return study(a)
+    return study(a)
+
+
+def study(a) -> int:
     sweep = [int(x) for x in a.sweep.split(",")]
     path = Path(a.rows)
     rows = pd.read_csv(path) if path.exists() else pd.DataFrame()
