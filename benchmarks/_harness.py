@@ -2,8 +2,9 @@
 process and the median/ratio table.
 
 A comparison runs the same worker on two trees: an export of the baseline commit (`git
-archive` of `suds_exp/`, `cli.py` and `pyproject.toml` into a temporary folder) and the working tree. Rounds
-alternate (A B A B ...), so a change in the machine's load hits both sides. A worker is a
+archive` of `suds_exp/`, `cli.py` and `pyproject.toml` into a temporary folder) and the
+working tree. Rounds alternate (A B A B ...), so a change in the machine's load hits both
+sides. A worker is a
 ``python -m benchmarks.<...> --worker ...`` process whose `suds_exp` is its tree's: the
 tree comes first on its path, then the working tree's root for the `benchmarks` package
 itself (an export holds no `benchmarks/`). It prints one JSON document as its last line.

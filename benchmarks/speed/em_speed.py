@@ -2,7 +2,8 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.speed.em_speed [--baseline c2aa7be] [--rounds 7]
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.speed.em_speed [--baseline c2aa7be] \
+        [--rounds 7] [--quick]
 
 The baseline's `suds_exp/models/mixture.py` is read with `git show` and loaded beside the
 current one. The inputs are the standardised training matrices GMR and GMR+SUDS hand to
@@ -79,7 +80,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     k, sizes = 16, {}
     if a.quick:
-        a.baseline, a.rounds, k, sizes = "HEAD", 1, 4, {"n_draws": 1, "cycles": 5, "trial_cycles": 8}
+        a.baseline, a.rounds, k = "HEAD", 1, 4
+        sizes = {"n_draws": 1, "cycles": 5, "trial_cycles": 8}
     with tempfile.TemporaryDirectory() as tmp:
         old = _old_mixture(a.baseline, Path(tmp))
         pairs: dict[int, list] = {}

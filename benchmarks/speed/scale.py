@@ -178,7 +178,9 @@ def main(argv=None) -> int:
     # the commands' processes import this PYTHONPATH's suds_exp (this tree's by default),
     # the measuring wrapper this tree's benchmarks
     paths = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
-    os.environ["PYTHONPATH"] = os.pathsep.join([*paths, str(ROOT)] if str(ROOT) not in paths else paths)
+    os.environ["PYTHONPATH"] = os.pathsep.join(
+        [*paths, str(ROOT)] if str(ROOT) not in paths else paths
+    )
     a.folder.mkdir(parents=True, exist_ok=True)
     sizes = [float(s) for s in a.sizes.split(",")]
     commands = a.commands.split(",")

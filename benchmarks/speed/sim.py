@@ -61,7 +61,10 @@ def speed(runs: int, effects: list[str] = (), design: dict | None = None) -> Non
         cpu.append(robot_s / (c1 - c0))
         wall.append(robot_s / (w1 - w0))
     worst = max(float(np.nanmax(t["residual"])) for t in truths)
-    print(f"{'design' if design else 'default dataset'}: {len(specs)} trials, {robot_s:.0f} s of robot time")
+    print(
+        f"{'design' if design else 'default dataset'}: {len(specs)} trials, "
+        f"{robot_s:.0f} s of robot time"
+    )
     print(
         f"physics: {statistics.median(cpu):.0f}x real time per CPU-second "
         f"(runs {', '.join(f'{v:.0f}' for v in cpu)}); "

@@ -9,7 +9,8 @@ Usage::
     # a quick look at a reduced scale
     .venv/bin/python -m benchmarks.studies.findings --seeds 0 --boots 2 --sweep 1-3,30
     # another robot: a simulator config file, effects over it
-    .venv/bin/python -m benchmarks.studies.findings --seeds 0 --config examples/calibrated_robot.toml
+    .venv/bin/python -m benchmarks.studies.findings --seeds 0 \
+        --config examples/calibrated_robot.toml
 
 For each dataset seed (``--seeds``): simulate the paper's design with the default
 simulator (`simulate_dataset`; the robot of ``--config`` with the effects of ``--set``),

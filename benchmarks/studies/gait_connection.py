@@ -16,7 +16,8 @@ Why the extra gaits: the paper's five gaits all circle the origin in one sense, 
 shape the data hold one direction of shape velocity (the five cross at shallow angles);
 the second column of A is then an extrapolation of the learner, not a measurement.
 
-Run: .venv/bin/python -m benchmarks.studies.gait_connection [--extra] [--out reports/gait-connection]
+Run: .venv/bin/python -m benchmarks.studies.gait_connection [--extra]
+    [--out reports/gait-connection] [--quick]
 """
 
 from __future__ import annotations

@@ -16,7 +16,8 @@ so the order where phase-only's held-out error stops falling, and whether TLS im
 its own constant term, can be read off.
 
     make demo     # or any database with the default dataset preprocessed as v1
-    .venv/bin/python -m benchmarks.studies.phase_only --db suds.duckdb --prep v1 --orders 5,6,8,10,12
+    .venv/bin/python -m benchmarks.studies.phase_only --db suds.duckdb --prep v1 \
+        --orders 5,6,8,10,12
 """
 
 from __future__ import annotations

@@ -2,7 +2,8 @@
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python -m benchmarks.studies.reduction --db survey.duckdb \
+    OMP_NUM_THREADS=1 nice -n 10 .venv/bin/python -m benchmarks.studies.reduction \
+        --db survey.duckdb \
         [--reductions pca,kernel-pca,autoencoder] [--models TLS+SUDS,GMR+SUDS,GMR] \
         [--conditions O@0.5,D+@0.5,S-@1] [--boots 4] [--jobs 2]
 
