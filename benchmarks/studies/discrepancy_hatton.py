@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -36,8 +37,9 @@ from suds_exp.sim.dataset import plan_trials, simulate_trials, truth_markers
 from suds_exp.sim.files import write_manifest, write_qtm_tsv
 from suds_exp.sim.markers import MARKER_NAMES, measure
 
-TABLE = ROOT / ".." / "shared" / "refdata"
-TABLE = TABLE / "hatton_granular_three_link_connection.mat"
+#: The table in the reference data, ../shared beside the repository or $SUDS_SHARED.
+SHARED = Path(os.environ.get("SUDS_SHARED") or ROOT.parent / "shared")
+TABLE = SHARED / "refdata" / "hatton_granular_three_link_connection.mat"
 #: The notes' probable relabelling of the table's grid (true angle = label x 1.142).
 GRID_SCALE = 1.142
 DESIGN = dict(gaits=("S+", "O", "D+"), frequencies_hz=(1 / 3, 0.5, 1.0), repeats=4, cycles=(4, 6))
