@@ -10,7 +10,7 @@ Data: the physics simulator, gait O at `--freq` Hz, `--cycles` cycles a trial, o
 per seed with the change and one per seed without (seeds 0..N-1 and 1000..1000+N-1),
 samples straight from the truth (r_a = joint angles, r_p = the four flipper angles,
 rates by central differences) with Gaussian noise of 1 mm/s on vx, vy and 0.01 rad/s on
-wz, as benchmarks/models.py. Each learner runs prequentially (`suds_exp.stream.run_trial`,
+wz, as benchmarks/speed/models.py. Each learner runs prequentially (`suds_exp.stream.run_trial`,
 10 warm-up cycles, then predict, score, learn each cycle; batch learners stay as the
 warm-up left them).
 
