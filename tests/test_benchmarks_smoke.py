@@ -33,7 +33,9 @@ def test_every_script_sits_in_a_box_and_takes_quick():
     for module in SCRIPTS:
         text = (ROOT / (module.replace(".", "/") + ".py")).read_text()
         assert '"--quick"' in text, f"{module} has no --quick"
-        assert "python -m " + module in text, f"{module}'s docstring does not say how to run it"
+        assert re.search(rf"python3? -m {re.escape(module)}\b", text), (
+            f"{module}'s docstring does not say how to run it"
+        )
 
 
 def test_no_script_edits_the_import_path():
