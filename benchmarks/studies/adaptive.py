@@ -25,7 +25,7 @@ GMR's error on the fixed unseen gaits of `suds_exp.plan.unseen_gaits` (RMS dista
 predicted from simulated net displacement per cycle, mm) for grid, random and the
 plan loop with --goal map.
 
-Run: .venv/bin/python benchmarks/adaptive.py --seeds 0,1,2 --budget 50 --bo-budget 150
+Run: .venv/bin/python -m benchmarks.studies.adaptive --seeds 0,1,2 --budget 50 --bo-budget 150
          [--map-budget 390 --map-arms plan,fullgrid] [--designer] [--out reports/adaptive]
 
 For the map goal's plan loop the benchmark also measures where the map-error curve
@@ -39,8 +39,9 @@ Writes curves.csv, summary.json and the figures gait.png (and map.png) to --out.
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
-import sys
+import shutil
 import tempfile
 import time
 from pathlib import Path
@@ -48,23 +49,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.gait.design import DesignOptions, design_gait  # noqa: E402
-from suds_exp.gait.motion import cycle_motion  # noqa: E402
-from suds_exp.gait.predict import derive_seed, fit_map  # noqa: E402
-from suds_exp.gait.shape import FourierGait, NamedGait, within_bound  # noqa: E402
-from suds_exp.gait.trials import gait_trial_specs  # noqa: E402
-from suds_exp.gait.truth import simulate_forward  # noqa: E402
-from suds_exp.ingest import ingest_paths  # noqa: E402
-from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop  # noqa: E402
-from suds_exp.plan.ensemble import block_draws  # noqa: E402
-from suds_exp.plan.recommend import Trial  # noqa: E402
-from suds_exp.plan.record import record_trial  # noqa: E402
-from suds_exp.preprocess import get_version, preprocess  # noqa: E402
-from suds_exp.sim import SimConfig, simulate_dataset  # noqa: E402
-from suds_exp.sim.dataset import plan_trials, simulate_trials  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.gait.design import DesignOptions, design_gait
+from suds_exp.gait.motion import cycle_motion
+from suds_exp.gait.predict import derive_seed, fit_map
+from suds_exp.gait.shape import FourierGait, NamedGait, within_bound
+from suds_exp.gait.trials import gait_trial_specs
+from suds_exp.gait.truth import simulate_forward
+from suds_exp.ingest import ingest_paths
+from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop
+from suds_exp.plan.ensemble import block_draws
+from suds_exp.plan.recommend import Trial
+from suds_exp.plan.record import record_trial
+from suds_exp.preprocess import get_version, preprocess
+from suds_exp.sim import SimConfig, simulate_dataset
+from suds_exp.sim.dataset import plan_trials, simulate_trials
+from suds_exp.store import Store
 
 FREQ = 0.5
 ORDER = 2
@@ -302,7 +301,7 @@ def first_reaching(rows: list[dict], level: float) -> int | None:
     return None
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", default="0,1,2")
     ap.add_argument("--budget", type=int, default=50, help="cycles of the gait-goal arms")
@@ -322,7 +321,13 @@ def main() -> None:
         help="map-goal arms (grid, random, plan, fullgrid: the full grid's error alone)",
     )  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("reports/adaptive"))
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny budgets")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.seeds, args.budget, args.cycles, args.arms = "0", 6, 2, "random,plan"
+        args.map_budget, args.map_arms, args.spread_boots = 6, "random", 2
+        args.out = Path(tempfile.mkdtemp(prefix="suds-adaptive-quick-"))
+        atexit.register(shutil.rmtree, args.out, True)
     args.out.mkdir(parents=True, exist_ok=True)
     seeds = [int(s) for s in args.seeds.split(",")]
     arms = [a for a in args.arms.split(",") if a]

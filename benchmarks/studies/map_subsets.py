@@ -7,45 +7,51 @@ The recording: every paper gait at every paper frequency, two repeats of 10 cycl
 the unseen gaits (O, D-, S-) against all five, at 1/2 Hz (the target's frequency) or at
 all three frequencies, one repeat or two.
 
-Run: .venv/bin/python benchmarks/map_subsets.py [--seed 0] [--out /tmp/map_subsets]
+Run: .venv/bin/python -m benchmarks.studies.map_subsets [--seed 0] [--out /tmp/map_subsets]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
+import atexit
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from suds_exp.gait.predict import fit_map  # noqa: E402
-from suds_exp.ingest import ingest_paths  # noqa: E402
-from suds_exp.plan import Target, TargetTruth  # noqa: E402
-from suds_exp.preprocess import get_version, preprocess  # noqa: E402
-from suds_exp.robot import GAITS  # noqa: E402
-from suds_exp.sim import SimConfig, simulate_dataset  # noqa: E402
-from suds_exp.sim.dataset import draw_trial, trial_seed  # noqa: E402
-from suds_exp.store import Store  # noqa: E402
+from suds_exp.gait.predict import fit_map
+from suds_exp.ingest import ingest_paths
+from suds_exp.plan import Target, TargetTruth
+from suds_exp.preprocess import get_version, preprocess
+from suds_exp.robot import GAITS
+from suds_exp.sim import SimConfig, simulate_dataset
+from suds_exp.sim.dataset import draw_trial, trial_seed
+from suds_exp.store import Store
 
 FREQS = (1 / 3, 0.5, 1.0)
 NEAR = ["O", "D-", "S-"]
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", type=Path, default=Path("/tmp/map_subsets"))
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run: 4-cycle trials, 1 repeat")
+    args = ap.parse_args(argv)
+    cycles, repeats = (10, 10), (1, 2)
+    if args.quick:
+        cycles, repeats = (4, 4), (1,)
+        args.out = Path(tempfile.mkdtemp(prefix="suds-map-subsets-quick-"))
+        atexit.register(shutil.rmtree, args.out, True)
     args.out.mkdir(parents=True, exist_ok=True)
     store = Store(args.out / "subsets.duckdb")
     if not store.path.exists():
         specs = [
-            draw_trial(g, f, r, trial_seed(args.seed, g, f, r), (10, 10))
+            draw_trial(g, f, r, trial_seed(args.seed, g, f, r), cycles)
             for g in GAITS
             for f in FREQS
-            for r in (1, 2)
+            for r in repeats
         ]
         ds = simulate_dataset(args.out / "data", SimConfig(), specs=specs)
         ingest_paths(store, [], manifest=ds.manifest, progress=False)

@@ -3,10 +3,11 @@ contact (asymmetric_drag.ratio) against the learners, by the paper's protocol.
 
 Usage (from the repository root)::
 
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/momentum
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/momentum
         [--taus 0,0.1,0.25,0.5] [--ratios 1,1.5,2.5] [--boots 6] [--train-cycles 4]
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/x --synthetic
-    OMP_NUM_THREADS=1 .venv/bin/python benchmarks/momentum.py --out /tmp/x --snake ../shared/refdata
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/x --synthetic
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/x \
+        --snake ../shared/refdata
 
 For each value: `suds-exp simulate` (gait O at 1/3, 1/2 and 1 Hz, 2 trials of 12-16
 cycles each, the effect set, the rest nominal) with --ingest, `preprocess`, and a
@@ -30,11 +31,13 @@ import argparse
 import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from benchmarks._harness import ROOT
 from suds_exp.analysis.formatting import to_markdown
 
 N_BOOT = 2000
@@ -172,7 +175,7 @@ def flying_snake(refdata: Path) -> None:
     from suds_exp.store import Store
 
     capture = refdata / "flying_snake_qualisys" / "413_91.tsv"
-    body = Path(__file__).resolve().parents[1] / "examples" / "flying_snake.toml"
+    body = ROOT / "examples" / "flying_snake.toml"
     with tempfile.TemporaryDirectory() as tmp:
         db = Path(tmp) / "snake.duckdb"
         out = run_real_snake([capture], body, db)
@@ -183,16 +186,28 @@ def flying_snake(refdata: Path) -> None:
     print("\nGMR+P tau_ (s):", np.round(make_model("GMR+P").fit(train).tau_, 3))
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--out", type=Path, help="the databases' folder (required unless --quick)")
     ap.add_argument("--taus", default="0,0.1,0.25,0.5")
     ap.add_argument("--ratios", default="1,1.5,2.5")
     ap.add_argument("--boots", type=int, default=6)
     ap.add_argument("--train-cycles", type=int, default=4)
     ap.add_argument("--synthetic", action="store_true", help="the synthetic Finsler swimmer")
     ap.add_argument("--snake", type=Path, help="refdata folder: the flying snake, GMR vs GMR+P")
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="a smoke run: tau 0, one draw")
+    args = ap.parse_args(argv)
+    if args.quick:
+        with tempfile.TemporaryDirectory(prefix="suds-momentum-quick-") as tmp:
+            args.out, args.taus, args.ratios, args.boots = Path(tmp), "0", "", 1
+            study(args)
+        return
+    if args.out is None and not (args.synthetic or args.snake):
+        ap.error("--out is required")
+    study(args)
+
+
+def study(args) -> None:
     if args.synthetic:
         synthetic_finsler()
         return
