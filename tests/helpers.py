@@ -29,6 +29,7 @@ REPO = Path(__file__).resolve().parents[1]
 # (`--dist loadfile`): starting these first keeps one of them from being the last thing a
 # worker runs while the other waits.
 SLOW_FILES = (
+    "test_benchmarks_smoke.py",
     "test_discrepancy_workflow.py",
     "test_reliability.py",
     "test_gait_design.py",

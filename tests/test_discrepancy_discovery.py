@@ -276,7 +276,7 @@ def test_segment_sliding_is_each_segment_velocity_along_its_axis():
 
 def _withheld(effect: str, seed: int, workdir):
     """``effect`` hidden in the data and excluded from the candidates, as
-    `benchmarks/discrepancy.py --withheld` runs it at ``seed`` (its design is
+    `python -m benchmarks.studies.discrepancy --withheld` runs it at ``seed`` (its design is
     `hidden_effect_run`'s default: 3 gaits x 3 frequencies x 4 repeats, 4-6 cycles)."""
     from suds_exp.discrepancy import DiscrepancyOptions
     from suds_exp.workflows.hidden_effects import draw_hidden, hidden_effect_run

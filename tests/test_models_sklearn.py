@@ -472,7 +472,7 @@ def test_the_seed_tolerance_needs_two_seeds():
 def test_the_baselines_defaults_are_the_recipe_judged_in_the_speed_results():
     # docs/results/speed.md, "Session 15": every faster setting tried was outside the
     # baselines' own seed-to-seed spread, so the defaults stay the old recipe; a change of
-    # default must be judged again with benchmarks/survey_tolerance.py (whose OLD_RECIPES
+    # default must be judged again with benchmarks/studies/survey_tolerance.py (whose OLD_RECIPES
     # are these values: the recipe it judged, pinned here).
     judged = {
         "MLP": {"hidden_layer_sizes": [64, 64], "max_iter": 200, "tol": 1e-4},

@@ -53,7 +53,7 @@ def default_dataset(tmp_path_factory):
 
 @pytest.mark.slow
 def test_default_dataset_within_targets(default_dataset):
-    # its speed (target: under 30 s) is measured by benchmarks/preprocess.py, not here
+    # its speed (target: under 30 s) is measured by benchmarks/speed/preprocess.py, not here
     store, result = default_dataset
     assert len(result.processed) == 60
     pooled = truth_errors(store, result.version_id).set_index("trial_id").loc[-1]

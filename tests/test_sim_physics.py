@@ -215,4 +215,4 @@ def test_default_dataset_physics_converges_and_keeps_flippers_within_stops():
     for t in truths:
         fl = np.column_stack([t[f"flipper_{i}"] for i in range(1, 5)])
         assert fl.min() >= 0 and fl.max() <= amax + 1e-12
-    # its speed (target 300x real time per core) is measured by benchmarks/sim.py
+    # its speed (target 300x real time per core) is measured by benchmarks/speed/sim.py

@@ -1,0 +1,223 @@
+"""One campaign in-process, on 2 loky workers and on a real dask cluster over TCP, side by
+side in one run: wall time, speed-up, each job's own fit+predict time, the workers' CPU
+time, and whether the rows agree.
+
+Usage::
+
+    .venv/bin/python -m benchmarks.speed.dask_scaling                  # a small dataset
+    .venv/bin/python -m benchmarks.speed.dask_scaling --boots 10 --rounds 3
+    .venv/bin/python -m benchmarks.speed.dask_scaling \
+        --worker-env DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False
+
+The dataset (4 conditions, 2 repeats of 10 cycles, simulated once into a temporary
+folder, or ``--db``, a preprocessed database) is copied for every run. Each round runs,
+in turn: ``suds-exp run`` in-process (``-j 1``), with loky (``-j 2``), and with
+``--scheduler`` on a cluster this script starts on 127.0.0.1 (``dask scheduler`` and
+``--workers`` separate ``dask worker --nthreads 1 --no-nanny`` processes, 1 and 2 of
+them by default; ``--nanny`` keeps dask's nanny process), stopped after each run.
+``--worker-env`` sets environment variables of the dask workers only (to test what slows
+them down). Figures are medians over
+``--rounds``; "job" is a job's ``fit_seconds + predict_seconds`` as the results table
+stores it. ``--quick``: phase-only, one draw of 2 cycles, one dask worker (a smoke run).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from statistics import median
+
+import duckdb
+
+BIN = Path(sys.executable).parent
+
+
+def _suds(*args: str) -> str:
+    out = subprocess.run([str(BIN / "suds-exp"), *args], capture_output=True, text=True)
+    if out.returncode:
+        raise SystemExit(f"suds-exp {' '.join(args)}: {out.stderr.strip()}")
+    return out.stdout
+
+
+def _dataset(folder: Path) -> Path:
+    db = folder / "base.duckdb"
+    _suds(
+        "simulate",
+        "--out",
+        str(folder / "sim"),
+        "--gaits",
+        "O,S+",
+        "--freqs",
+        "1/2,1",
+        "--repeats",
+        "2",
+        "--cycles",
+        "10",
+        "--ingest",
+        "--db",
+        str(db),
+        "-q",
+    )
+    _suds("preprocess", "--db", str(db), "-q")
+    return db
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class _Cluster:
+    """``dask scheduler`` and ``n`` ``dask worker --nthreads 1`` processes on 127.0.0.1."""
+
+    def __init__(self, n: int, env: dict[str, str], nanny: bool = False):
+        port = _free_port()
+        self.address = f"tcp://127.0.0.1:{port}"
+        quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+        self.scheduler = subprocess.Popen(
+            [
+                str(BIN / "dask"),
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                str(port),
+                "--dashboard-address",
+                "127.0.0.1:0",
+            ],
+            **quiet,
+        )
+        self.workers = [
+            subprocess.Popen(
+                [
+                    str(BIN / "dask"),
+                    "worker",
+                    self.address,
+                    "--nthreads",
+                    "1",
+                    *([] if nanny else ["--no-nanny"]),
+                    "--host",
+                    "127.0.0.1",
+                    "--dashboard-address",
+                    "127.0.0.1:0",
+                ],
+                env={**os.environ, **env},
+                **quiet,
+            )
+            for _ in range(n)
+        ]
+        from dask.distributed import Client
+
+        with Client(self.address, timeout=30) as client:
+            client.wait_for_workers(n, timeout=60)
+
+    def stop(self) -> None:
+        for p in [*self.workers, self.scheduler]:
+            p.terminate()
+        for p in [*self.workers, self.scheduler]:
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:  # a worker may linger on SIGTERM
+                p.kill()
+                p.wait(timeout=30)
+
+
+def _run(base: Path, folder: Path, label: str, a, extra: list[str]) -> dict:
+    db = folder / f"{label}.duckdb"
+    shutil.copy(base, db)
+    args = [
+        "run",
+        "c",
+        "--models",
+        a.models,
+        "--boots",
+        str(a.boots),
+        "--train-cycles",
+        str(a.train_cycles),
+        "--db",
+        str(db),
+        "--json",
+        "-q",
+        *extra,
+    ]
+    summary = json.loads(_suds(*args))
+    with duckdb.connect(str(db), read_only=True) as con:
+        job = con.sql("SELECT median(fit_seconds + predict_seconds) FROM results").fetchone()[0]
+        rows = con.sql(
+            "SELECT * EXCLUDE (fit_seconds, predict_seconds, finished_at) FROM results ORDER BY ALL"
+        ).df()
+    db.unlink()
+    digest = hashlib.sha256(rows.to_csv(index=False).encode()).hexdigest()[:12]
+    return {
+        "wall": summary["seconds"],
+        "job_ms": 1000 * job,
+        "jobs": summary["total_jobs"],
+        "digest": digest,
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--db", type=Path, help="a preprocessed database (default: simulate one)")
+    ap.add_argument("--models", default="phase-only,TLS,TLS+SUDS,GMR,GMR+SUDS")
+    ap.add_argument("--boots", type=int, default=4)
+    ap.add_argument("--train-cycles", type=int, default=5)
+    ap.add_argument("--rounds", type=int, default=1)
+    ap.add_argument("--workers", default="1,2", help="dask worker counts to run")
+    ap.add_argument("--worker-env", action="append", default=[], metavar="NAME=VALUE")
+    ap.add_argument("--nanny", action="store_true", help="workers under a nanny process")
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
+    a = ap.parse_args(argv)
+    if a.quick:
+        a.models, a.boots, a.train_cycles, a.workers, a.rounds = "phase-only", 1, 2, "1", 1
+    env = dict(item.split("=", 1) for item in a.worker_env)
+    counts = [int(n) for n in a.workers.split(",")]
+    with tempfile.TemporaryDirectory(prefix="suds-dask-") as tmp:
+        folder = Path(tmp)
+        base = a.db or _dataset(folder)
+        runs: dict[str, list[dict]] = {}
+        for _ in range(a.rounds):
+            runs.setdefault("in-process", []).append(_run(base, folder, "one", a, ["-j", "1"]))
+            runs.setdefault("loky -j 2", []).append(_run(base, folder, "loky", a, ["-j", "2"]))
+            for n in counts:
+                cluster = _Cluster(n, env, a.nanny)
+                try:
+                    r = _run(
+                        base,
+                        folder,
+                        f"dask{n}",
+                        a,
+                        ["--backend", "dask", "--scheduler", cluster.address, "-j", str(n)],
+                    )
+                finally:
+                    cluster.stop()
+                runs.setdefault(f"dask TCP, {n} worker(s)", []).append(r)
+    ref = runs["in-process"]
+    ref_wall, ref_job = median(r["wall"] for r in ref), median(r["job_ms"] for r in ref)
+    print(
+        f"{ref[0]['jobs']} jobs ({a.models}; {a.boots} draws, {a.train_cycles} cycles), "
+        f"{a.rounds} round(s), medians; worker env {env or 'default'}; "
+        f"{'with' if a.nanny else 'no'} nanny"
+    )
+    print(f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11}  rows")
+    for label, rs in runs.items():
+        wall, job = median(r["wall"] for r in rs), median(r["job_ms"] for r in rs)
+        same = "same" if {r["digest"] for r in rs} == {ref[0]["digest"]} else "DIFFER"
+        print(
+            f"{label:26} {wall:7.1f} {ref_wall / wall:7.2f}x {job:7.1f} {job / ref_job:10.2f}x "
+            f" {same}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,418 @@
+"""Fewest robot cycles: the planner against the paper's grid, random trials, Bayesian
+optimisation directly on the simulator and the designer fed the full grid.
+
+On each dataset seed (the simulator's noise draws of every trial), at equal budgets of
+recorded cycles (warm-up included), five ways of spending robot time:
+
+- ``grid``: the paper's design (5 gaits x 3 frequencies x 4 repeats, 10-30 cycles) in its
+  own order, learned after every trial;
+- ``random``: random order-2 Fourier gaits within the bound (as the ceiling benchmark's
+  global look draws them), `--cycles` cycles each at 1/2 Hz, learned after every trial;
+- ``plan``: `suds-exp plan loop` (`suds_exp.plan.run_loop`), from 5 cycles of O at 1/2 Hz;
+- ``bo``: Bayesian optimisation (`bayesian-optimization`, default settings, 8 random
+  starts) of the same Fourier gait's 10 coefficients, each evaluation one trial of
+  `--cycles` cycles whose forward displacement per cycle is measured on the trial itself
+  (actuator noise included, cycles after the first averaged); no map;
+- ``designer`` (with --designer): `gait design --iterations 5 --verify` from the full grid
+  (also GMR's error on the unseen gaits learned from the full grid, the map goal's bar).
+
+Every arm's best gait is scored the same way, on the simulator with the gait followed
+exactly (`suds_exp.gait.truth`): the gait-goal curve is that forward displacement per
+cycle against cycles recorded, as a share of --ceiling (mm per cycle, from
+`benchmarks/gait_ceiling.py`). The best gait of a learning arm is the recorded gait its
+map predicts best; of BO, the best evaluation. The map-goal curve (--map-budget > 0) is
+GMR's error on the fixed unseen gaits of `suds_exp.plan.unseen_gaits` (RMS distance of
+predicted from simulated net displacement per cycle, mm) for grid, random and the
+plan loop with --goal map.
+
+Run: .venv/bin/python -m benchmarks.studies.adaptive --seeds 0,1,2 --budget 50 --bo-budget 150
+         [--map-budget 390 --map-arms plan,fullgrid] [--designer] [--out reports/adaptive]
+
+For the map goal's plan loop the benchmark also measures where the map-error curve
+flattens (the next doubling of cycles lowers the error by less than its bootstrap
+spread, GMR refitted on cycle-block resamples) and whether the loop's stopping signal
+first fired within 20 % of that count (`flattening`, in summary.json).
+Writes curves.csv, summary.json and the figures gait.png (and map.png) to --out.
+(`pip install -e '.[bench]'` installs bayesian-optimization.)
+"""
+
+from __future__ import annotations
+
+import argparse
+import atexit
+import json
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from suds_exp.gait.design import DesignOptions, design_gait
+from suds_exp.gait.motion import cycle_motion
+from suds_exp.gait.predict import derive_seed, fit_map
+from suds_exp.gait.shape import FourierGait, NamedGait, within_bound
+from suds_exp.gait.trials import gait_trial_specs
+from suds_exp.gait.truth import simulate_forward
+from suds_exp.ingest import ingest_paths
+from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop
+from suds_exp.plan.ensemble import block_draws
+from suds_exp.plan.recommend import Trial
+from suds_exp.plan.record import record_trial
+from suds_exp.preprocess import get_version, preprocess
+from suds_exp.sim import SimConfig, simulate_dataset
+from suds_exp.sim.dataset import plan_trials, simulate_trials
+from suds_exp.store import Store
+
+FREQ = 0.5
+ORDER = 2
+
+
+def random_gait(rng, bound: float, name: str) -> FourierGait:
+    """The ceiling benchmark's random look: first harmonic ~ N(0, 1) rad, higher ones
+    ~ N(0, 0.3), centre ~ U(-0.3, 0.3), projected into the bound."""
+    scale = np.r_[[0.3, 0.3], np.tile([1.0] * 2 + [0.3] * 2 * (ORDER - 1), 2)]
+    x = rng.normal(size=2 + 4 * ORDER) * scale
+    x[:2] = rng.uniform(-0.3, 0.3, size=2)
+    return within_bound(FourierGait.from_vector(x, name), bound)
+
+
+class Learner:
+    """An arm that records trials one by one into its own database and learns after each:
+    the curve's rows (cycles, best gait's simulator forward, map error)."""
+
+    def __init__(self, work: Path, truth: TargetTruth):
+        self.store = Store(work / "arm.duckdb")
+        self.work, self.truth = work, truth
+        self.gaits, self.cycles, self.rows, self.version = [], 0, [], None
+        self.achieved: dict[str, float] = {}
+
+    def record(self, trial: Trial, seed: int) -> None:
+        # one folder a trial: a declared level's folder keeps its repeat number
+        trial_id = record_trial(self.store, trial, self.work / f"t{len(self.rows)}", seed)
+        if self.version is None:
+            preprocess(self.store, trials=[trial_id], progress=False)
+            self.version = get_version(self.store)
+        else:
+            v = self.version
+            preprocess(self.store, v.name, params=v.params, trials=[trial_id], progress=False)
+        self.cycles += trial.cycles
+        if all(g.name != trial.gait.name for g in self.gaits):
+            self.gaits.append(trial.gait)
+        fitted = fit_map(get_version(self.store).samples())
+        preds = [fitted.forward(g, FREQ) for g in self.gaits]
+        best = self.gaits[int(np.argmax(preds))]
+        if best.name not in self.achieved:
+            self.achieved[best.name] = float(simulate_forward([best], FREQ)[0])
+        self.rows.append(
+            {
+                "cycles": self.cycles,
+                "best_forward_mm": self.achieved[best.name],
+                "map_error_mm": self.truth.map_error(fitted),
+            }
+        )
+
+
+def arm_grid(seed: int, budget: int, truth: TargetTruth, work: Path) -> list[dict]:
+    arm = Learner(work, truth)
+    for spec in plan_trials(seed=seed):
+        if arm.cycles + spec.n_cycles > budget:
+            break
+        arm.record(Trial(NamedGait(spec.gait), spec.frequency_hz, spec.n_cycles), seed)
+    return arm.rows
+
+
+def arm_random(seed: int, budget: int, cycles: int, bound: float, truth, work) -> list[dict]:
+    arm = Learner(work, truth)
+    rng = np.random.default_rng([seed, 11])
+    k = 0
+    while arm.cycles + cycles <= budget:
+        name = f"random-s{seed}-{k}.toml"
+        arm.record(Trial(random_gait(rng, bound, name), FREQ, cycles, name), seed)
+        k += 1
+    return arm.rows
+
+
+def arm_plan(
+    seed: int, budget: int, goal: str, bound: float, cycles: int, work, truth=None,
+    spread_boots: int = 8,
+) -> list[dict]:  # fmt: skip
+    """The loop's curve rows; for the map goal (``truth`` given) each row also has the
+    bootstrap spread of the map error (`error_spread`) and the loop's stop signal."""
+    opts = LoopOptions(goal=goal, bound=bound, budget_cycles=budget, seed=seed, cycles=cycles)
+    store = Store(work / "plan.duckdb")
+    loop = run_loop(store, opts, out=work / "plan")
+    rows = [
+        {
+            "cycles": it.cycles_recorded,
+            "best_forward_mm": it.achieved_forward_mm,
+            "map_error_mm": it.map_error,
+            "stop": bool(it.stop),
+            "trial": f"{it.trial['gait']}@{it.trial['frequency_hz']:g}",
+        }
+        for it in loop.iterations
+    ]
+    if truth is not None:
+        samples = get_version(store, loop.prep_version).samples()
+        trial_ids = [it.trial_id for it in loop.iterations]
+        for k, row in enumerate(rows):
+            part = samples[samples["trial_id"].isin(trial_ids[: k + 1])]
+            key = derive_seed("flat", seed, k)
+            row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
+    return rows
+
+
+def error_spread(samples: pd.DataFrame, truth: TargetTruth, seed: int, n_boot: int = 8) -> float:
+    """Bootstrap standard deviation (mm) of GMR's error on the unseen gaits: GMR refitted
+    on ``n_boot`` cycle-block resamples of ``samples`` (`suds_exp.plan.ensemble`)."""
+    errors = [truth.map_error(fit_map(f)) for f in block_draws(samples, n_boot, seed)]
+    return float(np.std(errors, ddof=1))
+
+
+def flattening(rows: list[dict]) -> dict:
+    """Where the measured map-error curve flattens and where the stop signal first fired.
+
+    Flattens at c: the first recorded count c for which the curve reaches 2 c and the
+    error at the first count >= 2 c is lower than at c by less than the bootstrap spread
+    of the error at c. The signal is within 20 % when |fired - c| <= 0.2 c."""
+    flat = None
+    for r in rows:
+        later = [q for q in rows if q["cycles"] >= 2 * r["cycles"]]
+        if r["cycles"] <= 0 or not later:
+            continue
+        drop = r["map_error_mm"] - later[0]["map_error_mm"]
+        if drop < r["error_spread_mm"]:
+            flat = {"cycles": r["cycles"], "drop_mm": drop, "spread_mm": r["error_spread_mm"],
+                    "doubled_at": later[0]["cycles"]}  # fmt: skip
+            break
+    fired = next((r["cycles"] for r in rows if r["stop"]), None)
+    within = None
+    if flat is not None and fired is not None:
+        within = abs(fired - flat["cycles"]) <= 0.2 * flat["cycles"]
+    return {"flattens_at": flat, "signal_first_at": fired, "within_20_percent": within}
+
+
+def measured_forward(gait, cycles: int, seed: int, config: SimConfig) -> float:
+    """Forward displacement per cycle measured on one simulated trial of ``gait`` (the
+    actuator's lag and noise included), cycles after the first averaged."""
+    (spec,) = gait_trial_specs(gait, (FREQ,), 1, (cycles, cycles), seed)
+    (truth,) = simulate_trials([spec], config)
+    per = int(round(config.measurement.sample_rate_hz / FREQ))
+    poses = np.column_stack([truth[c] for c in ("x", "y", "theta")])
+    return cycle_motion(poses, per, range(1, cycles)).forward_mm
+
+
+def arm_bo(seed: int, budget: int, cycles: int, bound: float) -> list[dict]:
+    from bayes_opt import BayesianOptimization
+
+    config = SimConfig()
+    keys = [f"x{i}" for i in range(2 + 4 * ORDER)]
+    pbounds = {k: ((-0.3, 0.3) if i < 2 else (-bound, bound)) for i, k in enumerate(keys)}
+    n_evals = budget // cycles
+    state = {"n": 0, "best": -np.inf, "gait": None}
+    rows = []
+    achieved: dict[int, float] = {}
+
+    def objective(**kw):
+        state["n"] += 1
+        x = np.array([kw[k] for k in keys])
+        gait = within_bound(FourierGait.from_vector(x, f"bo-{state['n']}"), bound)
+        value = measured_forward(gait, cycles, derive_seed("bo", seed, state["n"]), config)
+        if value > state["best"]:
+            state["best"], state["gait"] = value, gait
+        key = id(state["gait"])
+        if key not in achieved:
+            achieved[key] = float(simulate_forward([state["gait"]], FREQ)[0])
+        rows.append({"cycles": state["n"] * cycles, "best_forward_mm": achieved[key]})
+        return value
+
+    opt = BayesianOptimization(objective, pbounds, random_state=seed, verbose=0)
+    opt.maximize(init_points=min(8, n_evals), n_iter=max(0, n_evals - 8))
+    return rows
+
+
+def arm_designer(seed: int, bound: float, truth: TargetTruth, work: Path) -> dict:
+    """The full grid: its GMR map's error on the unseen gaits, then `gait design
+    --iterations 5 --verify` from it (the best verified gait)."""
+    store = Store(work / "grid.duckdb")
+    ds = simulate_dataset(work / "grid", seed=seed)
+    ingest_paths(store, [], manifest=ds.manifest, progress=False)
+    preprocess(store, progress=False)
+    cycles = int(round(sum(s.n_cycles for s in plan_trials(seed=seed))))
+    error = truth.map_error(fit_map(get_version(store).samples()))
+    opts = DesignOptions(bound=bound, iterations=5, verify=True)
+    design = design_gait(store, None, opts, work / "design")
+    best = max(it.achieved.forward_mm for it in design.iterations)
+    return {
+        "cycles": cycles + 5 * opts.cycles,
+        "best_forward_mm": best,
+        "grid_cycles": cycles,
+        "grid_map_error_mm": error,
+    }
+
+
+def arm_fullgrid(seed: int, truth: TargetTruth, work: Path) -> dict:
+    """GMR's error on the unseen gaits learned from the paper's full grid (the map goal's
+    bar) and the grid's cycles."""
+    store = Store(work / "grid.duckdb")
+    ds = simulate_dataset(work / "grid", seed=seed)
+    ingest_paths(store, [], manifest=ds.manifest, progress=False)
+    preprocess(store, progress=False)
+    cycles = int(round(sum(s.n_cycles for s in plan_trials(seed=seed))))
+    samples = get_version(store).samples()
+    error = truth.map_error(fit_map(samples))
+    spread = error_spread(samples, truth, derive_seed("flat-grid", seed))
+    return {"cycles": cycles, "map_error_mm": error, "error_spread_mm": spread}
+
+
+def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[list[dict], float]:
+    """One arm's curve rows on dataset ``seed`` within ``budget`` cycles, and its wall s."""
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        if arm == "plan":
+            # kept: a plan loop stopped half-way continues where it ended when run again
+            work = args.out / f"work-{goal}-plan-s{seed}"
+            work.mkdir(parents=True, exist_ok=True)
+        if arm == "grid":
+            rows = arm_grid(seed, budget, truth, work)
+        elif arm == "random":
+            rows = arm_random(seed, budget, args.cycles, args.bound, truth, work)
+        elif arm == "plan":
+            rows = arm_plan(
+                seed, budget, goal, args.bound, args.cycles, work,
+                truth if goal == "map" else None, args.spread_boots,
+            )  # fmt: skip
+        elif arm == "fullgrid":
+            rows = [arm_fullgrid(seed, truth, work)]
+        elif arm == "bo":
+            rows = arm_bo(seed, args.bo_budget, args.cycles, args.bound)
+        else:
+            rows = [arm_designer(seed, args.bound, truth, work)]
+    return rows, time.perf_counter() - started
+
+
+def first_reaching(rows: list[dict], level: float) -> int | None:
+    """Cycles recorded when the best gait first reaches ``level`` mm per cycle."""
+    for r in rows:
+        if r["best_forward_mm"] >= level:
+            return int(r["cycles"])
+    return None
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", default="0,1,2")
+    ap.add_argument("--budget", type=int, default=50, help="cycles of the gait-goal arms")
+    ap.add_argument("--bo-budget", type=int, default=150, help="cycles of Bayesian optimisation")
+    ap.add_argument("--map-budget", type=int, default=0, help="cycles of the map-goal arms")
+    ap.add_argument("--cycles", type=int, default=5, help="cycles per planned/random/BO trial")
+    ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
+    ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
+    ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms ('' for none)")
+    ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
+    ap.add_argument(
+        "--spread-boots", type=int, default=8,
+        help="bootstrap refits of the map error's spread (the flattening check)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--map-arms", default="grid,random,plan",
+        help="map-goal arms (grid, random, plan, fullgrid: the full grid's error alone)",
+    )  # fmt: skip
+    ap.add_argument("--out", type=Path, default=Path("reports/adaptive"))
+    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny budgets")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.seeds, args.budget, args.cycles, args.arms = "0", 6, 2, "random,plan"
+        args.map_budget, args.map_arms, args.spread_boots = 6, "random", 2
+        args.out = Path(tempfile.mkdtemp(prefix="suds-adaptive-quick-"))
+        atexit.register(shutil.rmtree, args.out, True)
+    args.out.mkdir(parents=True, exist_ok=True)
+    seeds = [int(s) for s in args.seeds.split(",")]
+    arms = [a for a in args.arms.split(",") if a]
+    truth = TargetTruth(Target.of(bound=args.bound))
+    curves, summary = [], {"ceiling_mm": args.ceiling, "seeds": seeds, "arms": {}}
+    for seed in seeds:
+        for arm in arms + (["designer"] if args.designer else []):
+            rows, seconds = run_arm(arm, "gait", seed, args.budget, args, truth)
+            curves += [{"goal": "gait", "arm": arm, "seed": seed} | r for r in rows]
+            last = rows[-1]
+            entry = {
+                "cycles": last["cycles"],
+                "best_forward_mm": round(last["best_forward_mm"], 2),
+                "share_of_ceiling": round(last["best_forward_mm"] / args.ceiling, 3),
+                "cycles_to_80": first_reaching(rows, 0.8 * args.ceiling),
+                "cycles_to_90": first_reaching(rows, 0.9 * args.ceiling),
+                "seconds": round(seconds, 1),
+            }
+            if arm == "designer":
+                entry["grid_cycles"] = last["grid_cycles"]
+                entry["grid_map_error_mm"] = round(last["grid_map_error_mm"], 3)
+            summary["arms"].setdefault(arm, {})[str(seed)] = entry
+            print(f"gait seed {seed} {arm}: {entry}", flush=True)
+            save(curves, summary, args.out)
+        map_arms = [a for a in args.map_arms.split(",") if a]
+        for arm in map_arms if args.map_budget > 0 else ():
+            rows, seconds = run_arm(arm, "map", seed, args.map_budget, args, truth)
+            curves += [{"goal": "map", "arm": arm, "seed": seed} | r for r in rows]
+            entry = {
+                "cycles": rows[-1]["cycles"],
+                "map_error_mm": round(rows[-1]["map_error_mm"], 3),
+                "seconds": round(seconds, 1),
+            }
+            if "error_spread_mm" in rows[-1]:
+                entry["error_spread_mm"] = round(rows[-1]["error_spread_mm"], 3)
+            if arm == "plan":
+                entry["flattening"] = flattening(rows)
+            summary.setdefault("map", {}).setdefault(arm, {})[str(seed)] = entry
+            print(f"map seed {seed} {arm}: {entry}", flush=True)
+            save(curves, summary, args.out)
+    draw(pd.DataFrame(curves), args.ceiling, args.out)
+    print(f"wrote {args.out}/curves.csv, summary.json and figures")
+
+
+def save(curves: list[dict], summary: dict, out: Path) -> None:
+    """curves.csv and summary.json as they stand (after every arm: a long run that stops
+    keeps what it measured)."""
+    pd.DataFrame(curves).to_csv(out / "curves.csv", index=False, float_format="%.4f")
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+
+
+def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    colours = {"grid": "C0", "random": "C1", "plan": "C2", "bo": "C3", "designer": "C4"}
+    colours["fullgrid"] = "C0"
+    for goal, column, label in (
+        ("gait", "best_forward_mm", "best gait on the simulator (share of the ceiling)"),
+        ("map", "map_error_mm", "GMR error on the unseen gaits (mm per cycle)"),
+    ):
+        part = frame[frame["goal"] == goal]
+        if part.empty:
+            continue
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        for (arm, seed), rows in part.groupby(["arm", "seed"]):
+            y = rows[column] / ceiling if goal == "gait" else rows[column]
+            style = "o" if len(rows) == 1 else "-"
+            ax.plot(
+                rows["cycles"], y, style, color=colours.get(arm, "k"), alpha=0.8,
+                label=arm if seed == part["seed"].min() else None,
+            )  # fmt: skip
+        if goal == "gait":
+            for level in (0.8, 0.9):
+                ax.axhline(level, color="grey", lw=0.6, ls="--")
+        ax.set_xscale("log")
+        ax.set_xlabel("cycles recorded (warm-up included)")
+        ax.set_ylabel(label)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / f"{goal}.png", dpi=110)
+        plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
