@@ -13,8 +13,9 @@ The dataset (4 conditions, 2 repeats of 10 cycles, simulated once into a tempora
 folder, or ``--db``, a preprocessed database) is copied for every run. Each round runs,
 in turn: ``suds-exp run`` in-process (``-j 1``), with loky (``-j 2``), and with
 ``--scheduler`` on a cluster this script starts on 127.0.0.1 (``dask scheduler`` and
-``--workers`` separate ``dask worker --nthreads 1 --no-nanny --preload suds_exp.campaign.dask_worker`` processes, 1 and 2 of
-them by default; ``--nanny`` keeps dask's nanny process), stopped after each run.
+``--workers`` separate ``dask worker --nthreads 1 --no-nanny --preload
+suds_exp.campaign.dask_worker`` processes, 1 and 2 of them by default; ``--nanny`` keeps
+dask's nanny process), stopped after each run.
 ``--worker-env`` sets environment variables of the dask workers only (to test what slows
 them down). Figures are medians over
 ``--rounds``; "job" is a job's ``fit_seconds + predict_seconds`` as the results table
