@@ -199,6 +199,58 @@ def flying_snake(refdata: Path) -> None:
     print("\nGMR+P tau_ (s):", np.round(make_model("GMR+P").fit(train).tau_, 3))
 
 
+def why_tau(out: Path, tau: str) -> None:
+    """Where GMR+P's time constants go wrong on the simulator (body_inertia.tau_s=tau):
+    fitted on cycles 2-5 of every trial (about 50 samples a cycle, as
+    `momentum_information` takes them) pooled and per frequency, on the preprocessed
+    velocity and on the simulator's own (``*.truth.parquet``, interpolated to the samples'
+    times); then how much of (preprocessed - simulator) velocity an instantaneous map
+    linear in dr_a/dt (coefficients affine in r_a) explains."""
+    from suds_exp.models import make_model
+    from suds_exp.store import Store
+
+    db = dataset(out, f"body_inertia.tau_s={tau}")
+    folder = out / db.stem
+    s = (
+        Store(db)
+        .query_df(
+            "SELECT s.*, tr.frequency_hz, tr.source_file FROM samples s "
+            "JOIN trials tr ON tr.id = s.trial_id ORDER BY s.trial_id, s.t"
+        )
+        .dropna(axis=1, how="all")
+    )
+    parts = []
+    for (_, source), g in s.groupby(["trial_id", "source_file"]):
+        truth = pd.read_parquet(folder / Path(source).name.replace(".tsv", ".truth.parquet"))
+        parts.append(g.assign(**{f"{c}_sim": np.interp(g["t"], truth["t"], truth[c])
+                                 for c in ("vx", "vy", "wz")}))  # fmt: skip
+    s = pd.concat(parts)
+    first = s.groupby("trial_id")["cycle"].transform("min")
+    s = s[(s["cycle"] >= first + 1) & (s["cycle"] < first + 5)]
+    per_cycle = s.groupby("trial_id")["t"].transform("size") / 4
+    s = s[(s.groupby("trial_id").cumcount() % np.maximum(1, np.round(per_cycle / 50))) == 0]
+    sim = s.assign(vx=s["vx_sim"], vy=s["vy_sim"], wz=s["wz_sim"])
+    rows = []
+    for label, data in (("preprocessed", s), ("simulator's", sim)):
+        for f, g in [("all", data), *data.groupby("frequency_hz")]:
+            tau_ = make_model("GMR+P").fit(g).tau_
+            rows.append({"velocity": label, "trained on (Hz)": f if f == "all" else f"{f:.3g}",
+                         "tau vx, vy, wz (s)": ", ".join(f"{v:.3f}" for v in tau_)})  # fmt: skip
+    print(f"\n## GMR+P's time constants at tau_s = {tau} s\n")
+    print(to_markdown(pd.DataFrame(rows)))
+    ra, dra = s[["ra_1", "ra_2"]].to_numpy(), s[["dra_1", "dra_2"]].to_numpy()
+    X = np.column_stack([dra, (ra[:, :, None] * dra[:, None, :]).reshape(len(s), 4),
+                         np.ones(len(s))])  # fmt: skip
+    rows = []
+    for c in ("vx", "vy", "wz"):
+        e = (s[c] - s[f"{c}_sim"]).to_numpy()
+        b = np.linalg.lstsq(X, e, rcond=None)[0]
+        share = 1 - np.var(e - X @ b) / np.var(e)
+        rows.append({"component": c, "RMS of the difference": f"{e.std():.3f}",
+                     "explained by an instantaneous map": f"{share:.2f}"})  # fmt: skip
+    print("\n" + to_markdown(pd.DataFrame(rows)))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, required=True)
@@ -208,7 +260,12 @@ def main() -> None:
     ap.add_argument("--train-cycles", type=int, default=4)
     ap.add_argument("--synthetic", action="store_true", help="the synthetic Finsler swimmer")
     ap.add_argument("--snake", type=Path, help="refdata folder: the flying snake, GMR vs GMR+P")
+    ap.add_argument("--why-tau", metavar="TAU", help="GMR+P's time constants against the truth")
     args = ap.parse_args()
+    if args.why_tau:
+        args.out.mkdir(parents=True, exist_ok=True)
+        why_tau(args.out, args.why_tau)
+        return
     if args.synthetic:
         synthetic_finsler()
         return
