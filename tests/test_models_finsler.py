@@ -67,6 +67,12 @@ def test_tls_f_recovers_an_asymmetric_map_its_linear_twin_cannot():
     assert finsler <= 0.3 * rmse(make_model("TLS"), train, test)
 
 
+def test_on_a_linear_map_tls_f_is_as_good_as_its_linear_twin():
+    train, test = both_ways(1.0, 10, 0.5, 1), both_ways(1.0, 5, 0.5, 7, 10)
+    linear = rmse(make_model("TLS+F", split=False), train, test)
+    assert rmse(make_model("TLS+F"), train, test) <= 1.05 * linear
+
+
 def test_tls_f_is_homogeneous_of_degree_one_in_the_shape_velocity():
     """Trained at 1/2 Hz, TLS+F predicts the gait at 1 Hz: twice the velocity."""
     model = make_model("TLS+F").fit(swimmer(2.5, 10, 0.5, 1))

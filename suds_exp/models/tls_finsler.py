@@ -17,7 +17,10 @@ dr_a/dt (A_+ = A_-), TLS+F's linear twin for an ablation.
 Fit: the phase offset from the bin centre multiplies every rate regressor too (the drift
 of A across the window; dropped after the fit, as in TLS), and each output is solved by
 `tls.tls_solve` through the origin: the total least squares of the samples together with
-their mirror image (-X, -y), whose means are zero, is the uncentred one. A rate part that
+their mirror image (-X, -y), whose means are zero, is the uncentred one. A bin keeps
+separate maps only where they pay for their parameters: the same solve with A+ = A- (the
+regressors of each pair summed) is preferred when its BIC is no larger, as it is where
+the data pass the bin's shapes one way only or the map is linear there. A rate part that
 never occurs inside a bin (a joint that only opens there) has no coefficient in it; its
 coefficient there is interpolated from the neighbouring bins where it was seen.
 Coefficients are interpolated linearly over phase between bin centres rather than by a
@@ -53,6 +56,22 @@ def finsler_features(delta: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Regressors [u, delta x u], shape (n, s + m s), every one of degree one in u."""
     prod = (delta[:, :, None] * u[:, None, :]).reshape(len(u), -1)
     return np.hstack([u, prod])
+
+
+def _merge(X: np.ndarray, m: int, scale: bool = False) -> np.ndarray:
+    """Split-rate regressors (n, q) -> the linear ones: every ([u_j]+, [u_j]-) pair summed
+    (scales: the pair's first, equal by construction). The split columns come in groups
+    of 2 m (u+ then u-), the linear ones in groups of m."""
+    n, q = X.shape
+    G = X.reshape(n, q // (2 * m), 2, m)
+    return (G[:, :, 0] if scale else G[:, :, 0] + G[:, :, 1]).reshape(n, q // 2)
+
+
+def _unmerge(B: np.ndarray, m: int, p: int) -> np.ndarray:
+    """Linear coefficients (q / 2, 3) -> split ones (p, 3) with A+ = A-, first p rows."""
+    h, o = B.shape
+    G = B.reshape(h // m, 1, m, o)
+    return np.concatenate([G, G], axis=1).reshape(2 * h, o)[:p]
 
 
 def _periodic_interp(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
@@ -168,6 +187,28 @@ class TLSFinsler(TLS):
             )
             coef[b] = B[:p]
             seen[b] = np.sqrt((X[idx] ** 2).mean(axis=0)) > self.min_spread * sx
+            if self.split:
+                # the bin keeps separate maps only where they pay for their parameters
+                # (BIC against A+ = A-, whose regressors are the sums of the split ones)
+                Xl = _merge(Xb, len(dra_cols))
+                _, Bl, _ = tls_solve(
+                    np.vstack([Xl, -Xl]),
+                    np.vstack([Y[idx], -Y[idx]]),
+                    self.tls_gap,
+                    _merge(sxb[None], len(dra_cols), scale=True)[0],
+                    sy,
+                    self.min_spread,
+                    self.ridge,
+                )
+                nb = len(idx)
+                rss_s = (((Y[idx] - Xb @ B) / sy) ** 2).sum()
+                rss_l = (((Y[idx] - Xl @ Bl) / sy) ** 2).sum()
+                k_s, k_l = 3 * Xb.shape[1], 3 * Xl.shape[1]
+                bic_s = 3 * nb * np.log(rss_s / (3 * nb)) + k_s * np.log(3 * nb)
+                bic_l = 3 * nb * np.log(rss_l / (3 * nb)) + k_l * np.log(3 * nb)
+                if bic_l <= bic_s:
+                    coef[b] = _unmerge(Bl, len(dra_cols), p)
+                    seen[b] = True
             n_kept += kept
             n_dirs += 3 * Xb.shape[1]
         for j in range(p):
