@@ -16,7 +16,7 @@ campaign (`run`) on every (train, test) frequency pair of O with `--boots` draws
 with the time constant `momentum_information` estimates on the version's samples (all
 frequencies pooled; a campaign's training set holds one frequency, which cannot tell a
 lag from another map) in a second campaign beside GMR, "GMR+P (pooled tau)", whose
-ratio is to that campaign's GMR (the same draws). ratio: phase-only, TLS, GMR, GMR+F.
+ratio is to that campaign's GMR (the same draws). ratio: phase-only, TLS, TLS+F, GMR, GMR+F.
 
 Printed per value: median held-out RMSE of vx, vy (mm/s), wz (rad/s) per learner,
 same- and different-frequency pairs apart, each with a 95% bootstrap interval of the
@@ -126,39 +126,55 @@ def diagnostic(db: Path) -> pd.DataFrame:
 
 
 def synthetic_finsler() -> None:
-    """GMR, GMR+F and TLS on the synthetic swimmer with a known asymmetric map
+    """The learners on the synthetic swimmer with a known asymmetric map
     (velocity="asymmetric", ratio 1 and 2.5): RMS error of (vx, vy) against the noise-free
-    velocity, trained on 2 trials of 10 cycles of O at 1/2 Hz, tested on 2 trials of 5
-    cycles of O at 1/2 and 1 Hz and D+ at 1/2 Hz; then TLS's prediction against the truth
-    at other frequencies (least-squares slope; 0.5 / f if TLS predicts the training
-    speed's velocity)."""
+    velocity. Two training sets of 20 cycles of O at 1/2 Hz: "forwards" (2 trials of 10
+    cycles), where each shape is passed with one sign of its shape velocity, and "both
+    ways" (10 cycles forwards, 10 backwards), where the two halves of the map both show;
+    tested on 5 cycles a trial of O at 1/2 and 1 Hz and D+ at 1/2 Hz, run the same
+    ways. "TLS+F linear" is TLS+F with split=False (its linear twin). Then TLS's
+    prediction against the truth at other frequencies (least-squares slope; 0.5 / f if
+    TLS predicts the training speed's velocity)."""
     from suds_exp.models import make_model
     from suds_exp.testing.synthetic_swimmer import make_samples
 
-    def swimmer(ratio, n, gait, f, seed, first):
-        return make_samples(n, gait=gait, frequency_hz=f, n_trials=2, seed=seed,
-                            passive="none", velocity="asymmetric", asymmetry=ratio,
-                            first_trial_id=first)  # fmt: skip
+    def swimmer(ratio, n, gait, f, seed, first, ways="forwards"):
+        kw = dict(gait=gait, frequency_hz=f, passive="none", velocity="asymmetric",
+                  asymmetry=ratio)  # fmt: skip
+        if ways == "forwards":
+            return make_samples(n, n_trials=2, seed=seed, first_trial_id=first, **kw)
+        return pd.concat([make_samples(n, seed=seed, first_trial_id=first, **kw),
+                          make_samples(n, seed=seed + 1, first_trial_id=first + 1,
+                                       direction=-1, **kw)], ignore_index=True)  # fmt: skip
 
+    learners = {"GMR": ("GMR", {}), "GMR+F": ("GMR+F", {}), "TLS": ("TLS", {}),
+                "TLS+F": ("TLS+F", {}), "TLS+F linear": ("TLS+F", {"split": False})}  # fmt: skip
     rows, slopes = [], []
-    for ratio in (1.0, 2.5):
-        train = swimmer(ratio, 10, "O", 0.5, 1, 1)
-        for gait, f in (("O", 0.5), ("O", 1.0), ("D+", 0.5)):
-            test = swimmer(ratio, 5, gait, f, 7, 10)
-            truth = test[["vx_true", "vy_true"]].to_numpy()
-            row = {"ratio": ratio, "test": f"{gait} at {f:g} Hz"}
-            for name in ("GMR", "GMR+F", "TLS"):
-                pred = make_model(name).fit(train).predict(test)[["vx", "vy"]].to_numpy()
-                row[name] = f"{np.sqrt(np.mean((pred - truth) ** 2)):.2f}"
-            row["GMR+F / GMR"] = f"{float(row['GMR+F']) / float(row['GMR']):.2f}"
-            rows.append(row)
-        tls = make_model("TLS").fit(train)
-        for f in (1 / 3, 1.0):
-            test = swimmer(ratio, 5, "O", f, 7, 10)
-            t, q = test["vx_true"].to_numpy(), tls.predict(test)["vx"].to_numpy()
-            slopes.append({"ratio": ratio, "test Hz": f"{f:.3g}",
-                           "slope of TLS's vx on the truth": f"{q @ t / (t @ t):.3f}",
-                           "training / test speed": f"{0.5 / f:.3f}"})  # fmt: skip
+    for ways in ("forwards", "both ways"):
+        for ratio in (1.0, 2.5):
+            train = swimmer(ratio, 10, "O", 0.5, 1, 1, ways)
+            for gait, f in (("O", 0.5), ("O", 1.0), ("D+", 0.5)):
+                test = swimmer(ratio, 5, gait, f, 7, 10, ways)
+                truth = test[["vx_true", "vy_true"]].to_numpy()
+                row = {"data": ways, "ratio": ratio, "test": f"{gait} at {f:g} Hz"}
+                err = {}
+                for label, (name, params) in learners.items():
+                    model = make_model(name, **params).fit(train)
+                    pred = model.predict(test)[["vx", "vy"]].to_numpy()
+                    err[label] = float(np.sqrt(np.mean((pred - truth) ** 2)))
+                    row[label] = f"{err[label]:.2f}"
+                row["GMR+F / GMR"] = f"{err['GMR+F'] / err['GMR']:.2f}"
+                row["TLS+F / TLS"] = f"{err['TLS+F'] / err['TLS']:.2f}"
+                row["TLS+F / linear"] = f"{err['TLS+F'] / err['TLS+F linear']:.2f}"
+                rows.append(row)
+            if ways == "forwards":
+                tls = make_model("TLS").fit(train)
+                for f in (1 / 3, 1.0):
+                    test = swimmer(ratio, 5, "O", f, 7, 10)
+                    t, q = test["vx_true"].to_numpy(), tls.predict(test)["vx"].to_numpy()
+                    slopes.append({"ratio": ratio, "test Hz": f"{f:.3g}",
+                                   "slope of TLS's vx on the truth": f"{q @ t / (t @ t):.3f}",
+                                   "training / test speed": f"{0.5 / f:.3f}"})  # fmt: skip
     print("\n## synthetic Finsler swimmer (RMS error of vx, vy, mm/s)\n")
     print(to_markdown(pd.DataFrame(rows)) + "\n\n" + to_markdown(pd.DataFrame(slopes)))
 
@@ -186,6 +202,58 @@ def flying_snake(refdata: Path) -> None:
     print("\nGMR+P tau_ (s):", np.round(make_model("GMR+P").fit(train).tau_, 3))
 
 
+def why_tau(out: Path, tau: str) -> None:
+    """Where GMR+P's time constants go wrong on the simulator (body_inertia.tau_s=tau):
+    fitted on cycles 2-5 of every trial (about 50 samples a cycle, as
+    `momentum_information` takes them) pooled and per frequency, on the preprocessed
+    velocity and on the simulator's own (``*.truth.parquet``, interpolated to the samples'
+    times); then how much of (preprocessed - simulator) velocity an instantaneous map
+    linear in dr_a/dt (coefficients affine in r_a) explains."""
+    from suds_exp.models import make_model
+    from suds_exp.store import Store
+
+    db = dataset(out, f"body_inertia.tau_s={tau}")
+    folder = out / db.stem
+    s = (
+        Store(db)
+        .query_df(
+            "SELECT s.*, tr.frequency_hz, tr.source_file FROM samples s "
+            "JOIN trials tr ON tr.id = s.trial_id ORDER BY s.trial_id, s.t"
+        )
+        .dropna(axis=1, how="all")
+    )
+    parts = []
+    for (_, source), g in s.groupby(["trial_id", "source_file"]):
+        truth = pd.read_parquet(folder / Path(source).name.replace(".tsv", ".truth.parquet"))
+        parts.append(g.assign(**{f"{c}_sim": np.interp(g["t"], truth["t"], truth[c])
+                                 for c in ("vx", "vy", "wz")}))  # fmt: skip
+    s = pd.concat(parts)
+    first = s.groupby("trial_id")["cycle"].transform("min")
+    s = s[(s["cycle"] >= first + 1) & (s["cycle"] < first + 5)]
+    per_cycle = s.groupby("trial_id")["t"].transform("size") / 4
+    s = s[(s.groupby("trial_id").cumcount() % np.maximum(1, np.round(per_cycle / 50))) == 0]
+    sim = s.assign(vx=s["vx_sim"], vy=s["vy_sim"], wz=s["wz_sim"])
+    rows = []
+    for label, data in (("preprocessed", s), ("simulator's", sim)):
+        for f, g in [("all", data), *data.groupby("frequency_hz")]:
+            tau_ = make_model("GMR+P").fit(g).tau_
+            rows.append({"velocity": label, "trained on (Hz)": f if f == "all" else f"{f:.3g}",
+                         "tau vx, vy, wz (s)": ", ".join(f"{v:.3f}" for v in tau_)})  # fmt: skip
+    print(f"\n## GMR+P's time constants at tau_s = {tau} s\n")
+    print(to_markdown(pd.DataFrame(rows)))
+    ra, dra = s[["ra_1", "ra_2"]].to_numpy(), s[["dra_1", "dra_2"]].to_numpy()
+    X = np.column_stack([dra, (ra[:, :, None] * dra[:, None, :]).reshape(len(s), 4),
+                         np.ones(len(s))])  # fmt: skip
+    rows = []
+    for c in ("vx", "vy", "wz"):
+        e = (s[c] - s[f"{c}_sim"]).to_numpy()
+        b = np.linalg.lstsq(X, e, rcond=None)[0]
+        share = 1 - np.var(e - X @ b) / np.var(e)
+        rows.append({"component": c, "RMS of the difference": f"{e.std():.3f}",
+                     "explained by an instantaneous map": f"{share:.2f}"})  # fmt: skip
+    print("\n" + to_markdown(pd.DataFrame(rows)))
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, help="the databases' folder (required unless --quick)")
@@ -195,6 +263,7 @@ def main(argv=None) -> None:
     ap.add_argument("--train-cycles", type=int, default=4)
     ap.add_argument("--synthetic", action="store_true", help="the synthetic Finsler swimmer")
     ap.add_argument("--snake", type=Path, help="refdata folder: the flying snake, GMR vs GMR+P")
+    ap.add_argument("--why-tau", metavar="TAU", help="GMR+P's time constants against the truth")
     ap.add_argument("--quick", action="store_true", help="a smoke run: tau 0, one draw")
     args = ap.parse_args(argv)
     if args.quick:
@@ -204,6 +273,10 @@ def main(argv=None) -> None:
         return
     if args.out is None and not (args.synthetic or args.snake):
         ap.error("--out is required")
+    if args.why_tau:
+        args.out.mkdir(parents=True, exist_ok=True)
+        why_tau(args.out, args.why_tau)
+        return
     study(args)
 
 
@@ -236,7 +309,7 @@ def study(args) -> None:
         print(to_markdown(table) + "\n\n" + to_markdown(ratios))
     for ratio in [v for v in args.ratios.split(",") if v]:
         db = dataset(args.out, f"asymmetric_drag.ratio={ratio}")
-        table, ratios = summary(campaign(db, "finsler", "phase-only,TLS,GMR,GMR+F", args))
+        table, ratios = summary(campaign(db, "finsler", "phase-only,TLS,TLS+F,GMR,GMR+F", args))
         print(f"\n## ratio = {ratio}\n")
         print(to_markdown(table) + "\n\n" + to_markdown(ratios))
 

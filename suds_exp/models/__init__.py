@@ -19,7 +19,8 @@ Momentum learners (`MOMENTUM_MODELS`, the paper's Future Work): `GMR+P` and
 to a learned quasi-static GMR map with learned time constants.
 
 `GMR+F` (`finsler.GMRFinsler`, `FINSLER_MODELS`): GMR on the positive and negative parts
-of each shape velocity, a map homogeneous but not linear in it (Finsler contact).
+of each shape velocity, a map homogeneous but not linear in it (Finsler contact);
+`TLS+F` (`tls_finsler.TLSFinsler`): phase-binned TLS of the same map around the mean gait.
 
 Beyond the paper (`sklearn_adapter.py`; names and recipes in `sklearn_recipes.py`):
 `MLP`, `MLP+SUDS`, `GBT`, `kNN`, `KRR` (each also `+SUDS`) and `sklearn:ClassName` /
@@ -52,6 +53,7 @@ from suds_exp.models.registry import (
 from suds_exp.models.sklearn_adapter import SklearnLearner
 from suds_exp.models.sklearn_recipes import make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
+from suds_exp.models.tls_finsler import TLSFinsler
 
 #: The paper's five by name (`registry.LEARNERS`, in its order).
 MODELS: dict[str, type[Learner]] = dict(
@@ -67,7 +69,9 @@ MOMENTUM_MODELS: dict[str, type[Learner]] = dict(
     zip(MOMENTUM_LEARNERS, (GMRMomentum, GMRSudsMomentum), strict=True)
 )
 #: Learners whose map is homogeneous but not linear in the shape velocity (`finsler.py`).
-FINSLER_MODELS: dict[str, type[Learner]] = dict(zip(FINSLER_LEARNERS, (GMRFinsler,), strict=True))
+FINSLER_MODELS: dict[str, type[Learner]] = dict(
+    zip(FINSLER_LEARNERS, (GMRFinsler, TLSFinsler), strict=True)
+)
 #: The survey's named baselines (scikit-learn regressors with documented defaults).
 BASELINE_NAMES = BASELINE_LEARNERS
 
@@ -132,6 +136,7 @@ __all__ = [
     "GMRSudsMomentum",
     "FINSLER_MODELS",
     "GMRFinsler",
+    "TLSFinsler",
     "make_model",
     "GMR",
     "GMRSuds",

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 SUDS_SUFFIX = "+SUDS"
 #: The suffix of a learner with a momentum state: ``GMR+P``, ``GMR+SUDS+P``.
 MOMENTUM_SUFFIX = "+P"
-#: The suffix of a learner whose map is not linear in the shape velocity: ``GMR+F``.
+#: The suffix of a learner whose map is not linear in the shape velocity: ``GMR+F``,
+#: ``TLS+F``.
 FINSLER_SUFFIX = "+F"
 #: Tags: the paper's five; ``models="survey"`` of a campaign; ``partial_fit``; the
 #: scikit-learn baselines of `baselines.BASELINES`.
@@ -65,8 +66,9 @@ REGISTRY: tuple[LearnerInfo, ...] = (
     # the paper's Future Work: a low-dimensional momentum state (models/momentum.py)
     _learner("GMR", False, name="GMR" + MOMENTUM_SUFFIX),
     _learner("GMR", True, name="GMR" + SUDS_SUFFIX + MOMENTUM_SUFFIX),
-    # and a map homogeneous but not linear in the shape velocity (models/finsler.py)
+    # and a map homogeneous but not linear in the shape velocity (models/finsler.py, models/tls_finsler.py)
     _learner("GMR", False, name="GMR" + FINSLER_SUFFIX),
+    _learner("TLS", False, name="TLS" + FINSLER_SUFFIX),
 )
 BY_NAME = {info.name: info for info in REGISTRY}
 

@@ -92,14 +92,15 @@ def _trial(
     rng,
     body_tau,
     asymmetry=1.0,
+    direction=1,
 ):
     n = int(round(n_cycles * spc))
     fs = f * spc
     nf = n * substeps
     tf = np.arange(nf) / (fs * substeps)
     theta0 = rng.uniform(0, 2 * np.pi)
-    theta = 2 * np.pi * f * tf + theta0
-    g, dg = gait_shape(gait, theta), gait_shape_rate(gait, theta)
+    theta = direction * 2 * np.pi * f * tf + theta0
+    g, dg = gait_shape(gait, theta), direction * gait_shape_rate(gait, theta)
     e, de = _wobble(tf, f, tube, rng)
     amp = 1.0 + e[:, :2]
     ra = g * amp + e[:, 2:]
@@ -155,6 +156,7 @@ def make_samples(
     seed: int = 0,
     body_tau: float = 0.0,
     asymmetry: float = 1.0,
+    direction: int = 1,
 ) -> pd.DataFrame:
     """A samples frame (columns of the `samples` table) from the synthetic swimmer.
 
@@ -163,7 +165,11 @@ def make_samples(
     G r_a(0) + `rp_start` (its equilibrium plus an offset). Measured columns
     get Gaussian noise: v (noise_v mm/s, noise_w rad/s), r_a and r_p (noise_r),
     dr_a/dt and dr_p/dt (noise_dr per s). Trials are `first_trial_id`, ... in order.
+    `direction` -1 runs the gait backwards (the phase decreases): the same shapes with
+    the opposite shape velocity, where a Finsler map's two halves both show.
     """
+    if direction not in (1, -1):
+        raise ConfigError(f"synthetic: direction={direction!r}; expected 1 or -1")
     if passive not in ("lag", "travel", "none"):
         raise ConfigError(f"synthetic: passive={passive!r}; expected lag, travel or none")
     if velocity not in ("linear", "finsler", "asymmetric"):
@@ -188,6 +194,7 @@ def make_samples(
             rng,
             body_tau,
             asymmetry,
+            direction,
         )
         n = len(t)
         d = {
