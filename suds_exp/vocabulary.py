@@ -80,9 +80,7 @@ REGISTRY: tuple[LearnerInfo, ...] = (
     _learner("GMR", True, "gradual.GradualGMRSuds", "online", name="GradualGMR+SUDS"),
     # the paper's Future Work: a low-dimensional momentum state (models/momentum.py)
     _learner("GMR", False, "momentum.GMRMomentum", name="GMR" + MOMENTUM_SUFFIX),
-    _learner(
-        "GMR", True, "momentum.GMRSudsMomentum", name="GMR" + SUDS_SUFFIX + MOMENTUM_SUFFIX
-    ),
+    _learner("GMR", True, "momentum.GMRSudsMomentum", name="GMR" + SUDS_SUFFIX + MOMENTUM_SUFFIX),
     # and a map homogeneous but not linear in the shape velocity (models/finsler.py)
     _learner("GMR", False, "finsler.GMRFinsler", name="GMR" + FINSLER_SUFFIX),
 )
