@@ -3,9 +3,12 @@ and the SQL table ``learners`` all follow it."""
 
 from __future__ import annotations
 
+import inspect
+
 import pytest
 
 from suds_exp.commands.campaign import parse_campaign_options
+from suds_exp.errors import ConfigError
 from suds_exp.models import (
     BASELINE_NAMES,
     FINSLER_MODELS,
@@ -123,3 +126,19 @@ def test_the_labels_of_every_learner_name_are_as_before(tmp_path):
         assert bool(row.suds) == (SUDS_SUFFIX in row.model if new else row.model.endswith("+SUDS"))
         assert bool(row.gmr) == (row.model.startswith("GMR") and not new), row
         assert bool(row.phase_only) == (row.model == "phase-only"), row
+
+
+@pytest.mark.parametrize(
+    "info", [i for i in REGISTRY if i.builder != ADAPTER], ids=lambda i: i.name
+)
+def test_the_declared_hyper_parameters_are_the_constructor_and_its_defaults(info):
+    cls = builder(info.name)
+    declared = {name: p.default for name, p in cls._hyper_parameters.items()}
+    assert cls().get_params() == declared
+    assert list(inspect.signature(cls).parameters) == list(declared)
+
+
+def test_a_bad_parameter_is_one_line_naming_it_and_what_was_expected():
+    with pytest.raises(ConfigError) as err:
+        make_model("GMR+SUDS+P", lag_min_gain=1.0).fit(None)
+    assert str(err.value) == "GMR+SUDS+P: lag_min_gain=1.0; expected a number in [0, 1)"
