@@ -1,13 +1,27 @@
-"""The learner registry is the one home of learner names (issue 29)."""
+"""The learner registry is the one home of learner names: the model lists, `make_model`
+and the SQL table ``learners`` all follow it."""
 
 from __future__ import annotations
+
+import inspect
 
 import pytest
 
 from suds_exp.commands.campaign import parse_campaign_options
-from suds_exp.models import BASELINE_NAMES, MODEL_NAMES, ONLINE_MODELS, make_model
+from suds_exp.errors import ConfigError
+from suds_exp.models import (
+    BASELINE_NAMES,
+    FINSLER_MODELS,
+    MODEL_NAMES,
+    MODELS,
+    MOMENTUM_MODELS,
+    ONLINE_MODELS,
+    builder,
+    make_model,
+)
 from suds_exp.models.baselines import BASELINES
 from suds_exp.models.registry import (
+    ADAPTER,
     FINSLER_LEARNERS,
     LEARNERS,
     MOMENTUM_LEARNERS,
@@ -39,6 +53,22 @@ def test_every_entry_builds_and_its_suds_flag_matches_its_name(info):
     # a suffix after +SUDS adds to the SUDS learner (GMR+SUDS+P: with momentum)
     assert info.suds == (SUDS_SUFFIX in info.name)
     assert info.family in info.name
+
+
+@pytest.mark.parametrize("info", REGISTRY, ids=lambda i: i.name)
+def test_every_entry_is_built_by_its_builder_under_its_name(info):
+    model = make_model(info.name)
+    assert type(model) is builder(info.name)
+    # a baseline shows its scikit-learn class's name (sklearn:MLPRegressor)
+    assert model.name == info.name or info.builder == ADAPTER
+
+
+def test_the_model_lists_are_the_registry_by_tag():
+    assert list(MODELS) == list(LEARNERS)
+    assert list(ONLINE_MODELS) == list(tagged("online"))
+    assert list(MOMENTUM_MODELS) == list(MOMENTUM_LEARNERS)
+    assert list(FINSLER_MODELS) == list(FINSLER_LEARNERS)
+    assert all(MODELS[n] is builder(n) for n in MODELS)
 
 
 def test_unknown_tag_is_refused():
@@ -96,3 +126,19 @@ def test_the_labels_of_every_learner_name_are_as_before(tmp_path):
         assert bool(row.suds) == (SUDS_SUFFIX in row.model if new else row.model.endswith("+SUDS"))
         assert bool(row.gmr) == (row.model.startswith("GMR") and not new), row
         assert bool(row.phase_only) == (row.model == "phase-only"), row
+
+
+@pytest.mark.parametrize(
+    "info", [i for i in REGISTRY if i.builder != ADAPTER], ids=lambda i: i.name
+)
+def test_the_declared_hyper_parameters_are_the_constructor_and_its_defaults(info):
+    cls = builder(info.name)
+    declared = {name: p.default for name, p in cls._hyper_parameters.items()}
+    assert cls().get_params() == declared
+    assert list(inspect.signature(cls).parameters) == list(declared)
+
+
+def test_a_bad_parameter_is_one_line_naming_it_and_what_was_expected():
+    with pytest.raises(ConfigError) as err:
+        make_model("GMR+SUDS+P", lag_min_gain=1.0).fit(None)
+    assert str(err.value) == "GMR+SUDS+P: lag_min_gain=1.0; expected a number in [0, 1)"

@@ -34,7 +34,21 @@ import pandas as pd
 from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import main_cycles
-from suds_exp.analysis.formatting import interval_text
+from suds_exp.analysis.findings_view import (  # the table as shown; also read from here
+    VERDICTS as VERDICTS,
+)
+from suds_exp.analysis.findings_view import (
+    findings_display as findings_display,
+)
+from suds_exp.analysis.findings_view import (
+    findings_headline as findings_headline,
+)
+from suds_exp.analysis.findings_view import (
+    findings_json as findings_json,
+)
+from suds_exp.analysis.findings_view import (
+    findings_summary as findings_summary,
+)
 from suds_exp.analysis.glm import formula_design, glm_formulas, glm_frame
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import is_paper
@@ -45,7 +59,6 @@ PHASE, TLS, TLSS, GMR, GMRS = LEARNERS
 #: A training size of at most this many cycles is "a few cycles" (F8).
 FEW_CYCLES = 3
 #: Verdicts, in the order a summary lists them.
-VERDICTS = ("holds", "unclear", "fails", "not measurable")
 _DRAW = ["train_gait", "train_frequency_hz", "test_gait", "test_frequency_hz", "boot", "n_cycles"]
 #: The columns of ``results_labelled`` the findings read (`findings` loads no others: at
 #: 10M results every column left out is 40-80 MB less).
@@ -647,24 +660,6 @@ def _row(
     return row
 
 
-def findings_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """One row per finding (F1 ... F10): ``finding``, ``verdict`` (holds when every part
-    holds, not measurable when any part is, else fails when any part fails, else unclear),
-    ``parts`` (ids of its statistics)."""
-    rows = []
-    for finding, g in table.groupby("finding", sort=False):
-        verdicts = set(g["verdict"])
-        for v in ("not measurable", "fails", "unclear"):
-            if v in verdicts:
-                verdict = v
-                break
-        else:
-            verdict = "holds"
-        rows.append({"finding": finding, "verdict": verdict, "parts": ", ".join(g["id"])})
-    # columns named even when nothing was measured (a design where no statistic applies)
-    return pd.DataFrame(rows, columns=["finding", "verdict", "parts"])
-
-
 #: What the findings say on a design other than the paper's (``{source}``: its file).
 DESIGN_CAVEAT = (
     "F1-F10 assume the paper's design (its gaits S+ < S- < O < D- < D+ and frequencies); "
@@ -712,50 +707,3 @@ def for_design(table: pd.DataFrame, source: str) -> pd.DataFrame:
         "left_out": [f"{r.id}: {r.reason}" for r in table[~measured].itertuples()],
     }
     return out
-
-
-def findings_display(table: pd.DataFrame, digits: int = 2) -> pd.DataFrame:
-    """The table as it is shown: ``id``, ``paper``, ``threshold``, ``value [low, high]``
-    (text) and ``verdict`` (with the reason when not measurable)."""
-
-    def interval(r) -> str:
-        return interval_text(r["value"], r["low"], r["high"], digits)
-
-    return pd.DataFrame(
-        {
-            "id": table["id"],
-            "paper finds": table["paper"],
-            "holds if": table["threshold"],
-            "value [95% interval]": table.apply(interval, axis=1),
-            "verdict": [
-                f"{v}: {why}" if v == "not measurable" else v
-                for v, why in zip(table["verdict"], table["reason"], strict=True)
-            ],
-        }
-    )
-
-
-def findings_headline(table: pd.DataFrame) -> str:
-    """One line: how many of the paper's ten findings hold, and on how many results."""
-    summary = findings_summary(table)
-    counts = summary["verdict"].value_counts()
-    parts = [f"{int(counts.get(v, 0))} {v}" for v in VERDICTS if counts.get(v, 0)]
-    a = table.attrs
-    return (
-        f"{int(counts.get('holds', 0))} of {len(summary)} findings hold ({', '.join(parts)}); "
-        f"{a.get('n_results', '?')} results, main size {a.get('main_cycles', '?')} cycles, "
-        f"{a.get('n_boot', '?')} bootstrap replicates"
-    )
-
-
-def findings_json(table: pd.DataFrame, campaign: str) -> dict:
-    """A JSON-safe document: ``campaign``, ``attrs``, ``findings`` (per-finding verdicts)
-    and ``statistics`` (the table's rows; NaN -> null)."""
-    rows = table.astype(object).where(table.notna(), None).to_dict(orient="records")
-    return {
-        "campaign": campaign,
-        **{k: v for k, v in table.attrs.items()},
-        "headline": findings_headline(table),
-        "findings": findings_summary(table).to_dict(orient="records"),
-        "statistics": rows,
-    }

@@ -34,7 +34,9 @@ Every learner is a scikit-learn estimator: `fit(samples) -> self`,
 from __future__ import annotations
 
 from functools import cache
+from importlib import import_module
 
+from suds_exp import vocabulary
 from suds_exp.errors import ConfigError
 from suds_exp.models.base import Learner, ModelError
 from suds_exp.models.finsler import GMRFinsler
@@ -43,58 +45,68 @@ from suds_exp.models.gradual import GradualGMRSuds
 from suds_exp.models.momentum import GMRMomentum, GMRSudsMomentum
 from suds_exp.models.online import OnlineGMR, OnlineGMRSuds
 from suds_exp.models.phase_only import PhaseOnly
-from suds_exp.models.registry import (
-    BASELINE_LEARNERS,
-    FINSLER_LEARNERS,
-    LEARNERS,
-    MOMENTUM_LEARNERS,
-    ONLINE_LEARNERS,
-)
 from suds_exp.models.sklearn_adapter import SklearnLearner
 from suds_exp.models.sklearn_recipes import make_adapter, recipe
 from suds_exp.models.tls import TLS, TLSSuds
 from suds_exp.models.tls_finsler import TLSFinsler
 
+
+def builder(name: str) -> type[Learner]:
+    """The class that builds the registered learner ``name`` (its registry `builder`);
+    KeyError for a name the registry does not hold."""
+    info = vocabulary.learner(name)
+    if info is None:
+        raise KeyError(name)
+    return _resolve(info.builder)
+
+
+@cache
+def _resolve(path: str) -> type[Learner]:
+    # "module.Class" inside suds_exp.models, or "package.module:Class" anywhere
+    if ":" in path:
+        module, attr = path.split(":")
+    else:
+        module, attr = path.rsplit(".", 1)
+        module = f"suds_exp.models.{module}"
+    return getattr(import_module(module), attr)
+
+
+def _builders(names) -> dict[str, type[Learner]]:
+    return {n: builder(n) for n in names}
+
+
 #: The paper's five by name (`registry.LEARNERS`, in its order).
-MODELS: dict[str, type[Learner]] = dict(
-    zip(LEARNERS, (PhaseOnly, TLS, TLSSuds, GMR, GMRSuds), strict=True)
-)
-MODEL_NAMES = LEARNERS
+MODELS: dict[str, type[Learner]] = _builders(vocabulary.LEARNERS)
+MODEL_NAMES = vocabulary.LEARNERS
 #: Learners with `partial_fit(samples)`; kept out of MODEL_NAMES (the paper's five).
-ONLINE_MODELS: dict[str, type[Learner]] = dict(
-    zip(ONLINE_LEARNERS, (OnlineGMR, OnlineGMRSuds, GradualGMRSuds), strict=True)
-)
+ONLINE_MODELS: dict[str, type[Learner]] = _builders(vocabulary.ONLINE_LEARNERS)
 #: Learners with a momentum state (`momentum.py`).
-MOMENTUM_MODELS: dict[str, type[Learner]] = dict(
-    zip(MOMENTUM_LEARNERS, (GMRMomentum, GMRSudsMomentum), strict=True)
-)
+MOMENTUM_MODELS: dict[str, type[Learner]] = _builders(vocabulary.MOMENTUM_LEARNERS)
 #: Learners whose map is homogeneous but not linear in the shape velocity (`finsler.py`).
-FINSLER_MODELS: dict[str, type[Learner]] = dict(
-    zip(FINSLER_LEARNERS, (GMRFinsler, TLSFinsler), strict=True)
-)
+FINSLER_MODELS: dict[str, type[Learner]] = _builders(vocabulary.FINSLER_LEARNERS)
 #: The survey's named baselines (scikit-learn regressors with documented defaults).
-BASELINE_NAMES = BASELINE_LEARNERS
+BASELINE_NAMES = vocabulary.BASELINE_LEARNERS
 
 
 def make_model(name: str, **params) -> Learner:
-    """A new, unfitted learner by name (see MODEL_NAMES) with the given hyper-parameters.
+    """A new, unfitted learner by name (any name of the registry, `suds_exp.vocabulary`)
+    with the given hyper-parameters.
 
-    Also the baselines (BASELINE_NAMES) and `sklearn:ClassName[+SUDS]` (see
-    `sklearn_recipes`). Unknown names or parameters raise ConfigError; parameter values are
-    checked by `fit` (by scikit-learn's own checks here for the adapter).
+    Also `sklearn:ClassName[+SUDS]` (see `sklearn_recipes`). Unknown names or parameters
+    raise ConfigError; parameter values are checked by `fit` (by scikit-learn's own checks
+    for the adapter).
     """
-    builders = {**MODELS, **ONLINE_MODELS, **MOMENTUM_MODELS, **FINSLER_MODELS}
-    adapter = make_adapter(name, params) if name not in builders else None
-    if adapter is not None:
-        return adapter
-    try:
-        cls = builders[name]
-    except KeyError:
+    info = vocabulary.learner(name)
+    if info is None or info.builder == vocabulary.ADAPTER:
+        adapter = make_adapter(name, params)
+        if adapter is not None:
+            return adapter
+    if info is None:
+        known = (i.name for i in vocabulary.REGISTRY)
         raise ConfigError(
-            f"unknown model {name!r}; expected one of "
-            f"{', '.join((*builders, *BASELINE_NAMES))}"
-            " or sklearn:ClassName"
-        ) from None
+            f"unknown model {name!r}; expected one of {', '.join(known)} or sklearn:ClassName"
+        )
+    cls = _resolve(info.builder)
     valid = _param_names(cls)
     bad = [p for p in params if p not in valid]
     if bad:
@@ -122,6 +134,7 @@ def model_recipe(model: Learner) -> dict:
 
 __all__ = [
     "BASELINE_NAMES",
+    "builder",
     "SklearnLearner",
     "model_recipe",
     "MODELS",

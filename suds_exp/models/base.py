@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 import pandas as pd
@@ -19,6 +20,7 @@ from sklearn.base import BaseEstimator
 
 from suds_exp.display import Summary
 from suds_exp.errors import ConfigError, ModelError
+from suds_exp.models.params import Param, init_from
 from suds_exp.robot import RA_COLUMNS, VB_COLUMNS
 
 _RP_PATTERN = re.compile(r"^rp_(\d+)$")
@@ -236,13 +238,37 @@ class Learner(Summary, BaseEstimator):
     """Common face of the learners: `fit(samples) -> self`, `predict(samples) -> DataFrame`.
 
     Subclasses set `name` (the learner name of `make_model`) and `suds` (whether the
-    learner models r_p and predicts dr_p/dt). A learner shows itself under that name, with
-    the parameters it changes from its defaults and whether it is fitted
-    (``GMR+SUDS(n_components=8) [fitted: 6 inputs]``; in a notebook, a table of all).
+    learner models r_p and predicts dr_p/dt), and declare their hyper-parameters once in
+    ``_hyper_parameters`` (name -> `params.Param`: default and constraint); the constructor and
+    `_validate_params` follow from that table (see `suds_exp.models.params`). A learner
+    shows itself under its name, with the parameters it changes from its defaults and
+    whether it is fitted (``GMR+SUDS(n_components=8) [fitted: 6 inputs]``; in a
+    notebook, a table of all).
     """
 
     name = "learner"
     suds = False
+    _hyper_parameters: ClassVar[dict[str, Param]] = {}
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        # a class that declares its parameters gets the constructor they describe; one
+        # that declares none (a variant with its parent's parameters) inherits its parent's
+        if "_hyper_parameters" in vars(cls) and "__init__" not in vars(cls):
+            cls.__init__ = init_from(cls._hyper_parameters)
+            cls.__init__.__qualname__ = f"{cls.__qualname__}.__init__"
+
+    def _validate_params(self) -> None:
+        """Check every declared hyper-parameter (in declaration order); the first bad one
+        raises a one-line ConfigError naming it and what was expected."""
+        for name, param in self._hyper_parameters.items():
+            if param.constraint is not None:
+                param.constraint.check(name, getattr(self, name), self)
+
+    def _validate(self) -> None:
+        """What `fit` checks before it reads any data: the declared constraints (a
+        learner with checks across its parameters extends this)."""
+        self._validate_params()
 
     def _state(self) -> str:
         n = getattr(self, "n_features_in_", None)

@@ -80,8 +80,6 @@ so the cost of a campaign is predictable.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pandas as pd
 
@@ -92,9 +90,6 @@ from suds_exp.models.base import (
     TimeSeries,
     actuated_columns,
     as_array,
-    check_choice,
-    check_float,
-    check_int,
     require_columns,
     rollout_bounds,
 )
@@ -105,7 +100,8 @@ from suds_exp.models.mixture import (
     responsibilities,
     row_max,
 )
-from suds_exp.models.suds_variant import check_mode, required_passive_columns
+from suds_exp.models.params import Integer, Options, Param, Real, Rule
+from suds_exp.models.suds_variant import SUDS_PARAMETERS, check_mode, required_passive_columns
 from suds_exp.robot import RA_COLUMNS, VB_COLUMNS
 
 
@@ -151,31 +147,48 @@ def forward_filter(log_emit, transition, priors, first) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True)
-class GMRDefaults:
-    """GMR's hyper-parameter defaults, the one home of each: `GMR`, `GMRSuds` and the
-    online learners (`online.py`, `gradual.py`) take theirs from `GMR_DEFAULTS`."""
-
-    n_components: int = 16
-    reg_covar: float = 1e-3
-    max_iter: int = 60
-    tol: float = 1e-3
-    augment: str = "homogeneous"
-    augment_range: tuple = (0.5, 2.0)
-    augment_copies: int = 1
-    augment_weight: float = 0.5
-    augment_power: float = 1.0
-    speed_floor: float = 0.1
-    branching: str = "none"
-    branch_mix: float = 0.1
-    branch_memory: float = 1.0
-    select_k: str = "none"
-    k_candidates: tuple = (4, 8, 12, 16)
-    random_state: int = 0
-    mode: str = "measured"
+def _augment_range(name: str, value, model) -> None:
+    ok = (
+        isinstance(value, tuple | list)
+        and len(value) == 2
+        and all(isinstance(v, int | float) for v in value)
+        and 0 < value[0] <= value[1]
+    )
+    if not ok:
+        raise ConfigError(
+            f"{model.name}: {name}={value!r}; expected (s_min, s_max) with 0 < s_min <= s_max"
+        )
 
 
-GMR_DEFAULTS = GMRDefaults()
+def _k_candidates(name: str, value, model) -> None:
+    # read only when BIC chooses K (select_k is declared, so checked, before it)
+    if model.select_k == "bic":
+        if not value:
+            raise ConfigError(f"{model.name}: {name} is empty; give at least one K")
+        for k in value:
+            Integer(1).check(name, k, model)
+
+
+#: GMR's hyper-parameters (see `GMR`), the one home of each default and check: the SUDS,
+#: momentum, Finsler and online learners take theirs from here.
+GMR_PARAMETERS: dict[str, Param] = {
+    "n_components": Param(16, Integer(1)),
+    "reg_covar": Param(1e-3, Real(0.0, strict=True)),
+    "max_iter": Param(60, Integer(1)),
+    "tol": Param(1e-3, Real(0.0)),
+    "augment": Param("homogeneous", Options(("homogeneous", "dilation", "none"))),
+    "augment_range": Param((0.5, 2.0), Rule(_augment_range)),
+    "augment_copies": Param(1, Integer(0)),
+    "augment_weight": Param(0.5, Real(0.0)),
+    "augment_power": Param(1.0, Real(0.0)),
+    "speed_floor": Param(0.1, Real(0.0, strict=True)),
+    "branching": Param("none", Options(("history", "filter", "none"))),
+    "branch_mix": Param(0.1, Real(0.0, high=1)),
+    "branch_memory": Param(1.0, Real(0.0, strict=True)),
+    "select_k": Param("none", Options(("none", "bic"))),
+    "k_candidates": Param((4, 8, 12, 16), Rule(_k_candidates)),
+    "random_state": Param(0, Integer(0)),
+}
 
 
 class GMR(Learner):
@@ -224,83 +237,13 @@ class GMR(Learner):
     """
 
     name = "GMR"
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        max_iter: int = GMR_DEFAULTS.max_iter,
-        tol: float = GMR_DEFAULTS.tol,
-        augment: str = GMR_DEFAULTS.augment,
-        augment_range: tuple = GMR_DEFAULTS.augment_range,
-        augment_copies: int = GMR_DEFAULTS.augment_copies,
-        augment_weight: float = GMR_DEFAULTS.augment_weight,
-        augment_power: float = GMR_DEFAULTS.augment_power,
-        speed_floor: float = GMR_DEFAULTS.speed_floor,
-        branching: str = GMR_DEFAULTS.branching,
-        branch_mix: float = GMR_DEFAULTS.branch_mix,
-        branch_memory: float = GMR_DEFAULTS.branch_memory,
-        select_k: str = GMR_DEFAULTS.select_k,
-        k_candidates: tuple = GMR_DEFAULTS.k_candidates,
-        random_state: int = GMR_DEFAULTS.random_state,
-    ):
-        self.n_components = n_components
-        self.reg_covar = reg_covar
-        self.max_iter = max_iter
-        self.tol = tol
-        self.augment = augment
-        self.augment_range = augment_range
-        self.augment_copies = augment_copies
-        self.augment_weight = augment_weight
-        self.augment_power = augment_power
-        self.speed_floor = speed_floor
-        self.branching = branching
-        self.branch_mix = branch_mix
-        self.branch_memory = branch_memory
-        self.select_k = select_k
-        self.k_candidates = k_candidates
-        self.random_state = random_state
+    _hyper_parameters = GMR_PARAMETERS
 
     # -- columns -------------------------------------------------------------------------
     def _columns(self, samples):
         """(input columns, output columns, rp columns, drp columns)."""
         ra, dra = actuated_columns(samples)
         return ra + dra, list(VB_COLUMNS), [], []
-
-    def _validate(self):
-        n = self.name
-        check_int("n_components", self.n_components, 1, n)
-        check_float("reg_covar", self.reg_covar, 0.0, n, strict=True)
-        check_int("max_iter", self.max_iter, 1, n)
-        check_float("tol", self.tol, 0.0, n)
-        check_choice("augment", self.augment, ("homogeneous", "dilation", "none"), n)
-        check_float("augment_power", self.augment_power, 0.0, n)
-        check_float("speed_floor", self.speed_floor, 0.0, n, strict=True)
-        rng_ok = (
-            isinstance(self.augment_range, tuple | list)
-            and len(self.augment_range) == 2
-            and all(isinstance(v, int | float) for v in self.augment_range)
-            and 0 < self.augment_range[0] <= self.augment_range[1]
-        )
-        if not rng_ok:
-            raise ConfigError(
-                f"{n}: augment_range={self.augment_range!r}; expected (s_min, s_max) "
-                "with 0 < s_min <= s_max"
-            )
-        check_int("augment_copies", self.augment_copies, 0, n)
-        check_float("augment_weight", self.augment_weight, 0.0, n)
-        check_choice("branching", self.branching, ("history", "filter", "none"), n)
-        check_float("branch_memory", self.branch_memory, 0.0, n, strict=True)
-        check_float("branch_mix", self.branch_mix, 0.0, n)
-        if self.branch_mix > 1:
-            raise ConfigError(f"{n}: branch_mix={self.branch_mix!r}; expected a number in [0, 1]")
-        check_choice("select_k", self.select_k, ("none", "bic"), n)
-        if self.select_k == "bic":
-            if not self.k_candidates:
-                raise ConfigError(f"{n}: k_candidates is empty; give at least one K")
-            for k in self.k_candidates:
-                check_int("k_candidates", k, 1, n)
-        check_int("random_state", self.random_state, 0, n)
 
     # -- fit -----------------------------------------------------------------------------
     def fit(self, samples: pd.DataFrame, y=None):
@@ -431,50 +374,7 @@ class GMRSuds(GMR):
 
     name = "GMR+SUDS"
     suds = True
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        max_iter: int = GMR_DEFAULTS.max_iter,
-        tol: float = GMR_DEFAULTS.tol,
-        augment: str = GMR_DEFAULTS.augment,
-        augment_range: tuple = GMR_DEFAULTS.augment_range,
-        augment_copies: int = GMR_DEFAULTS.augment_copies,
-        augment_weight: float = GMR_DEFAULTS.augment_weight,
-        augment_power: float = GMR_DEFAULTS.augment_power,
-        speed_floor: float = GMR_DEFAULTS.speed_floor,
-        branching: str = GMR_DEFAULTS.branching,
-        branch_mix: float = GMR_DEFAULTS.branch_mix,
-        branch_memory: float = GMR_DEFAULTS.branch_memory,
-        select_k: str = GMR_DEFAULTS.select_k,
-        k_candidates: tuple = GMR_DEFAULTS.k_candidates,
-        random_state: int = GMR_DEFAULTS.random_state,
-        mode: str = GMR_DEFAULTS.mode,
-    ):
-        super().__init__(
-            n_components,
-            reg_covar,
-            max_iter,
-            tol,
-            augment,
-            augment_range,
-            augment_copies,
-            augment_weight,
-            augment_power,
-            speed_floor,
-            branching,
-            branch_mix,
-            branch_memory,
-            select_k,
-            k_candidates,
-            random_state,
-        )
-        self.mode = mode
-
-    def _validate(self):
-        super()._validate()
-        check_mode(self.mode, self.name)
+    _hyper_parameters = GMR_PARAMETERS | SUDS_PARAMETERS
 
     def _columns(self, samples):
         rp, drp = required_passive_columns(samples, self.name)

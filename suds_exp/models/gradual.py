@@ -26,18 +26,15 @@ import numpy as np
 import pandas as pd
 from scipy.special import logsumexp
 
-from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
     Learner,
     ModelError,
     as_array,
-    check_float,
-    check_int,
     passive_columns,
     require_columns,
 )
-from suds_exp.models.gmr import GMR_DEFAULTS
-from suds_exp.models.online import ONLINE_DEFAULTS, OnlineGMR
+from suds_exp.models.online import ONLINE_PARAMETERS, OnlineGMR
+from suds_exp.models.params import Integer, Param, Real, pick
 from suds_exp.robot import DRA_COLUMNS, RA_COLUMNS, VB_COLUMNS
 
 _LOG_2PI = np.log(2 * np.pi)
@@ -108,30 +105,22 @@ class GradualGMRSuds(Learner):
     """
 
     name = "GradualGMR+SUDS"
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        forgetting: float = ONLINE_DEFAULTS.forgetting,
-        warmup_samples: int = ONLINE_DEFAULTS.warmup_samples,
-        sweeps: int = ONLINE_DEFAULTS.sweeps,
-        min_share: float = ONLINE_DEFAULTS.min_share,
-        window: int = 10,
-        min_gain: float = 0.05,
-        min_t: float = 3.0,
-        random_state: int = GMR_DEFAULTS.random_state,
-    ):
-        self.n_components = n_components
-        self.reg_covar = reg_covar
-        self.forgetting = forgetting
-        self.warmup_samples = warmup_samples
-        self.sweeps = sweeps
-        self.min_share = min_share
-        self.window = window
-        self.min_gain = min_gain
-        self.min_t = min_t
-        self.random_state = random_state
+    _hyper_parameters = {
+        **pick(
+            ONLINE_PARAMETERS,
+            "n_components",
+            "reg_covar",
+            "forgetting",
+            "warmup_samples",
+            "sweeps",
+            "min_share",
+        ),
+        "window": Param(10, Integer(1)),
+        "min_gain": Param(0.05, Real(0.0)),
+        # not checked, as before: any number is a threshold
+        "min_t": Param(3.0),
+        **pick(ONLINE_PARAMETERS, "random_state"),
+    }
 
     def _sub(self, n_passive: int) -> _PassiveSubset:
         return _PassiveSubset(
@@ -146,12 +135,7 @@ class GradualGMRSuds(Learner):
         )
 
     def _reset(self):
-        check_int("window", self.window, 1, self.name)
-        check_float("min_gain", self.min_gain, 0.0, self.name)
-        if self.forgetting >= 1 or self.forgetting < 0:
-            raise ConfigError(
-                f"{self.name}: forgetting={self.forgetting!r}; expected a number in [0, 1)"
-            )
+        self._validate_params()
         self.current_ = self._sub(0)
         self.candidate_ = None
         self.passive_columns_ = []

@@ -46,10 +46,11 @@ from suds_exp.models.base import (
     Columns,
     TimeSeries,
     as_array,
-    check_float,
     require_columns,
 )
-from suds_exp.models.gmr import GMR, GMR_DEFAULTS, GMRSuds
+from suds_exp.models.gmr import GMR, GMR_PARAMETERS, GMRSuds
+from suds_exp.models.params import Integer, Param, Real, Rule
+from suds_exp.models.suds_variant import SUDS_PARAMETERS
 from suds_exp.robot import VB_COLUMNS
 
 #: Most body-velocity components that can carry momentum (vx, vy, wz).
@@ -88,29 +89,21 @@ def lag_filter(values: np.ndarray, ts: TimeSeries, tau: float, phase=None) -> np
     return out
 
 
+#: What a momentum learner adds to its GMR's hyper-parameters (see `GMRMomentum`).
+MOMENTUM_PARAMETERS: dict[str, Param] = {
+    "n_momentum": Param(
+        MAX_MOMENTUM,
+        Integer(1, MAX_MOMENTUM, why="body-velocity components that may carry momentum"),
+    ),
+    "tau_max": Param(2.0, Real(0.0, strict=True)),
+    "momentum_ridge": Param(1e-3, Real(0.0)),
+    "lag_min_gain": Param(0.1, Real(0.0, high=1, high_open=True)),
+    "tau": Param(None, Rule(lambda name, value, model: model._fixed_tau())),
+}
+
+
 class _Momentum:
     """What GMR+P and GMR+SUDS+P share; mixed in before `GMR` / `GMRSuds`."""
-
-    def _validate(self):
-        super()._validate()
-        n = self.name
-        if (
-            isinstance(self.n_momentum, bool)
-            or not isinstance(self.n_momentum, int | np.integer)
-            or not 1 <= self.n_momentum <= MAX_MOMENTUM
-        ):
-            raise ConfigError(
-                f"{n}: n_momentum={self.n_momentum!r}; expected an integer from 1 to "
-                f"{MAX_MOMENTUM} (body-velocity components that may carry momentum)"
-            )
-        check_float("tau_max", self.tau_max, 0.0, n, strict=True)
-        check_float("momentum_ridge", self.momentum_ridge, 0.0, n)
-        check_float("lag_min_gain", self.lag_min_gain, 0.0, n)
-        self._fixed_tau()
-        if self.lag_min_gain >= 1:
-            raise ConfigError(
-                f"{n}: lag_min_gain={self.lag_min_gain!r}; expected a number in [0, 1)"
-            )
 
     def _fixed_tau(self) -> np.ndarray | None:
         """The given time constants (3,) in s, or None when they are to be estimated."""
@@ -297,54 +290,7 @@ class GMRMomentum(_Momentum, GMR):
     """
 
     name = "GMR+P"
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        max_iter: int = GMR_DEFAULTS.max_iter,
-        tol: float = GMR_DEFAULTS.tol,
-        augment: str = GMR_DEFAULTS.augment,
-        augment_range: tuple = GMR_DEFAULTS.augment_range,
-        augment_copies: int = GMR_DEFAULTS.augment_copies,
-        augment_weight: float = GMR_DEFAULTS.augment_weight,
-        augment_power: float = GMR_DEFAULTS.augment_power,
-        speed_floor: float = GMR_DEFAULTS.speed_floor,
-        branching: str = GMR_DEFAULTS.branching,
-        branch_mix: float = GMR_DEFAULTS.branch_mix,
-        branch_memory: float = GMR_DEFAULTS.branch_memory,
-        select_k: str = GMR_DEFAULTS.select_k,
-        k_candidates: tuple = GMR_DEFAULTS.k_candidates,
-        random_state: int = GMR_DEFAULTS.random_state,
-        n_momentum: int = MAX_MOMENTUM,
-        tau_max: float = 2.0,
-        momentum_ridge: float = 1e-3,
-        lag_min_gain: float = 0.1,
-        tau=None,
-    ):
-        super().__init__(
-            n_components,
-            reg_covar,
-            max_iter,
-            tol,
-            augment,
-            augment_range,
-            augment_copies,
-            augment_weight,
-            augment_power,
-            speed_floor,
-            branching,
-            branch_mix,
-            branch_memory,
-            select_k,
-            k_candidates,
-            random_state,
-        )
-        self.n_momentum = n_momentum
-        self.tau_max = tau_max
-        self.momentum_ridge = momentum_ridge
-        self.lag_min_gain = lag_min_gain
-        self.tau = tau
+    _hyper_parameters = GMR_PARAMETERS | MOMENTUM_PARAMETERS
 
     def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         self._check_fitted()
@@ -358,56 +304,7 @@ class GMRSudsMomentum(_Momentum, GMRSuds):
     r_p. Parameters of `GMRSuds` plus those of `GMRMomentum`."""
 
     name = "GMR+SUDS+P"
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        max_iter: int = GMR_DEFAULTS.max_iter,
-        tol: float = GMR_DEFAULTS.tol,
-        augment: str = GMR_DEFAULTS.augment,
-        augment_range: tuple = GMR_DEFAULTS.augment_range,
-        augment_copies: int = GMR_DEFAULTS.augment_copies,
-        augment_weight: float = GMR_DEFAULTS.augment_weight,
-        augment_power: float = GMR_DEFAULTS.augment_power,
-        speed_floor: float = GMR_DEFAULTS.speed_floor,
-        branching: str = GMR_DEFAULTS.branching,
-        branch_mix: float = GMR_DEFAULTS.branch_mix,
-        branch_memory: float = GMR_DEFAULTS.branch_memory,
-        select_k: str = GMR_DEFAULTS.select_k,
-        k_candidates: tuple = GMR_DEFAULTS.k_candidates,
-        random_state: int = GMR_DEFAULTS.random_state,
-        mode: str = GMR_DEFAULTS.mode,
-        n_momentum: int = MAX_MOMENTUM,
-        tau_max: float = 2.0,
-        momentum_ridge: float = 1e-3,
-        lag_min_gain: float = 0.1,
-        tau=None,
-    ):
-        super().__init__(
-            n_components,
-            reg_covar,
-            max_iter,
-            tol,
-            augment,
-            augment_range,
-            augment_copies,
-            augment_weight,
-            augment_power,
-            speed_floor,
-            branching,
-            branch_mix,
-            branch_memory,
-            select_k,
-            k_candidates,
-            random_state,
-            mode,
-        )
-        self.n_momentum = n_momentum
-        self.tau_max = tau_max
-        self.momentum_ridge = momentum_ridge
-        self.lag_min_gain = lag_min_gain
-        self.tau = tau
+    _hyper_parameters = GMR_PARAMETERS | SUDS_PARAMETERS | MOMENTUM_PARAMETERS
 
     def predict_array(self, samples: pd.DataFrame | Columns) -> np.ndarray:
         out = super().predict_array(samples)  # checks; dr_p/dt (and r_p) of GMR+SUDS

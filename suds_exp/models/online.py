@@ -35,40 +35,34 @@ machine; most of it is pandas column handling, not EM.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import pandas as pd
 from scipy.special import logsumexp
 
-from suds_exp.errors import ConfigError
 from suds_exp.models.base import (
     ModelError,
     actuated_columns,
     as_array,
-    check_choice,
-    check_float,
-    check_int,
     require_columns,
     rollout_bounds,
 )
-from suds_exp.models.gmr import GMR, GMR_DEFAULTS, GMRSuds
+from suds_exp.models.gmr import GMR, GMR_PARAMETERS, GMRSuds
 from suds_exp.models.mixture import Conditional, fit_mixture, log_gaussians
-from suds_exp.models.suds_variant import check_mode
+from suds_exp.models.params import Integer, Options, Param, Real, pick
+from suds_exp.models.suds_variant import SUDS_PARAMETERS
 
-
-@dataclass(frozen=True)
-class OnlineDefaults:
-    """Defaults of the online learners' own hyper-parameters, the one home of each
-    (`OnlineGMR`, `OnlineGMRSuds`, `gradual.GradualGMRSuds`); the rest are `GMR_DEFAULTS`."""
-
-    forgetting: float = 0.002
-    warmup_samples: int = 500
-    sweeps: int = 2
-    min_share: float = 0.05
-
-
-ONLINE_DEFAULTS = OnlineDefaults()
+#: The online learners' hyper-parameters: GMR's that stream learning keeps (the same
+#: defaults and checks; no dilation) and their own. `gradual.GradualGMRSuds` shares them.
+ONLINE_PARAMETERS: dict[str, Param] = {
+    **pick(GMR_PARAMETERS, "n_components", "reg_covar", "max_iter", "tol"),
+    "augment": Param("homogeneous", Options(("homogeneous", "none"))),
+    **pick(GMR_PARAMETERS, "augment_power", "speed_floor"),
+    "forgetting": Param(0.002, Real(0.0, high=1, high_open=True)),
+    "warmup_samples": Param(500, Integer(1)),
+    "sweeps": Param(2, Integer(1)),
+    "min_share": Param(0.05, Real(0.0)),
+    **pick(GMR_PARAMETERS, "random_state"),
+}
 
 
 class _OnlineMixin:
@@ -79,27 +73,10 @@ class _OnlineMixin:
     select_k = "none"
     augment_copies = 0
     augment_weight = 0.0
-    augment_range = GMR_DEFAULTS.augment_range
+    augment_range = GMR_PARAMETERS["augment_range"].default
     branch_mix = 0.0
     branch_memory = 1.0
     k_candidates = ()
-
-    def _validate(self):
-        n = self.name
-        check_int("n_components", self.n_components, 1, n)
-        check_float("reg_covar", self.reg_covar, 0.0, n, strict=True)
-        check_int("max_iter", self.max_iter, 1, n)
-        check_float("tol", self.tol, 0.0, n)
-        check_choice("augment", self.augment, ("homogeneous", "none"), n)
-        check_float("augment_power", self.augment_power, 0.0, n)
-        check_float("speed_floor", self.speed_floor, 0.0, n, strict=True)
-        check_float("forgetting", self.forgetting, 0.0, n)
-        if self.forgetting >= 1:
-            raise ConfigError(f"{n}: forgetting={self.forgetting!r}; expected a number in [0, 1)")
-        check_int("warmup_samples", self.warmup_samples, 1, n)
-        check_int("sweeps", self.sweeps, 1, n)
-        check_float("min_share", self.min_share, 0.0, n)
-        check_int("random_state", self.random_state, 0, n)
 
     # -- public ------------------------------------------------------------------------
     def fit(self, samples: pd.DataFrame, y=None):
@@ -296,34 +273,7 @@ class OnlineGMR(_OnlineMixin, GMR):
     """
 
     name = "OnlineGMR"
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        max_iter: int = GMR_DEFAULTS.max_iter,
-        tol: float = GMR_DEFAULTS.tol,
-        augment: str = GMR_DEFAULTS.augment,
-        augment_power: float = GMR_DEFAULTS.augment_power,
-        speed_floor: float = GMR_DEFAULTS.speed_floor,
-        forgetting: float = ONLINE_DEFAULTS.forgetting,
-        warmup_samples: int = ONLINE_DEFAULTS.warmup_samples,
-        sweeps: int = ONLINE_DEFAULTS.sweeps,
-        min_share: float = ONLINE_DEFAULTS.min_share,
-        random_state: int = GMR_DEFAULTS.random_state,
-    ):
-        self.n_components = n_components
-        self.reg_covar = reg_covar
-        self.max_iter = max_iter
-        self.tol = tol
-        self.augment = augment
-        self.augment_power = augment_power
-        self.speed_floor = speed_floor
-        self.forgetting = forgetting
-        self.warmup_samples = warmup_samples
-        self.sweeps = sweeps
-        self.min_share = min_share
-        self.random_state = random_state
+    _hyper_parameters = ONLINE_PARAMETERS
 
 
 class OnlineGMRSuds(_OnlineMixin, GMRSuds):
@@ -333,37 +283,4 @@ class OnlineGMRSuds(_OnlineMixin, GMRSuds):
     """
 
     name = "OnlineGMR+SUDS"
-
-    def __init__(
-        self,
-        n_components: int = GMR_DEFAULTS.n_components,
-        reg_covar: float = GMR_DEFAULTS.reg_covar,
-        max_iter: int = GMR_DEFAULTS.max_iter,
-        tol: float = GMR_DEFAULTS.tol,
-        augment: str = GMR_DEFAULTS.augment,
-        augment_power: float = GMR_DEFAULTS.augment_power,
-        speed_floor: float = GMR_DEFAULTS.speed_floor,
-        forgetting: float = ONLINE_DEFAULTS.forgetting,
-        warmup_samples: int = ONLINE_DEFAULTS.warmup_samples,
-        sweeps: int = ONLINE_DEFAULTS.sweeps,
-        min_share: float = ONLINE_DEFAULTS.min_share,
-        random_state: int = GMR_DEFAULTS.random_state,
-        mode: str = GMR_DEFAULTS.mode,
-    ):
-        self.n_components = n_components
-        self.reg_covar = reg_covar
-        self.max_iter = max_iter
-        self.tol = tol
-        self.augment = augment
-        self.augment_power = augment_power
-        self.speed_floor = speed_floor
-        self.forgetting = forgetting
-        self.warmup_samples = warmup_samples
-        self.sweeps = sweeps
-        self.min_share = min_share
-        self.random_state = random_state
-        self.mode = mode
-
-    def _validate(self):
-        super()._validate()
-        check_mode(self.mode, self.name)
+    _hyper_parameters = ONLINE_PARAMETERS | SUDS_PARAMETERS

@@ -12,9 +12,9 @@ from suds_exp.models import fourier
 from suds_exp.models.base import (
     Learner,
     as_array,
-    check_int,
     require_columns,
 )
+from suds_exp.models.params import Integer, Param
 from suds_exp.robot import VB_COLUMNS
 
 
@@ -34,12 +34,11 @@ class PhaseOnly(Learner):
     """
 
     name = "phase-only"
-
-    def __init__(self, order: int = fourier.PHASE_ORDER):
-        self.order = order
+    _hyper_parameters = {"order": Param(fourier.PHASE_ORDER, Integer(0))}
 
     def fit(self, samples: pd.DataFrame, y=None) -> PhaseOnly:
-        order = check_int("order", self.order, 0, self.name)
+        self._validate()
+        order = int(self.order)
         require_columns(samples, ("phase", *VB_COLUMNS), self.name)
         phase = as_array(samples, ["phase"], self.name)[:, 0]
         v = as_array(samples, VB_COLUMNS, self.name)

@@ -1,96 +1,53 @@
-"""Every named learner, once: its name, family, whether it uses SUDS, and its tags.
+"""The learner registry under the name the models box reads it by: `suds_exp.vocabulary`.
 
-The one home of learner names ("one home per fact"): the paper's five
-(`LEARNERS`), the survey's set (`SURVEY_LEARNERS`), the online learners and the
-scikit-learn baselines are read from `REGISTRY`, and so are the roles other modules give
-a learner (`PHASE_ONLY`, `TLS`, ... below). The SQL vocabulary table ``learners``
-(migration 019) holds the same rows; a test keeps the two equal.
-
-This module is plain data and imports nothing, so any module may read it.
+The registry lives at the bottom of the house so that the store can write the SQL table
+``learners`` from it; this module only re-exports its names.
 """
 
-from __future__ import annotations
-
-from dataclasses import dataclass
-
-#: The suffix of a learner that also sees the passive shape (SUDS): ``GMR+SUDS``.
-SUDS_SUFFIX = "+SUDS"
-#: The suffix of a learner with a momentum state: ``GMR+P``, ``GMR+SUDS+P``.
-MOMENTUM_SUFFIX = "+P"
-#: The suffix of a learner whose map is not linear in the shape velocity: ``GMR+F``,
-#: ``TLS+F``.
-FINSLER_SUFFIX = "+F"
-#: Tags: the paper's five; ``models="survey"`` of a campaign; ``partial_fit``; the
-#: scikit-learn baselines of `baselines.BASELINES`.
-TAGS = ("paper", "survey", "online", "baseline")
-
-
-@dataclass(frozen=True)
-class LearnerInfo:
-    """One learner: ``name`` as `make_model` takes it and ``results.model`` stores it,
-    ``family`` (the learner without SUDS), ``suds`` (it uses the passive shape) and
-    ``tags`` (a subset of `TAGS`)."""
-
-    name: str
-    family: str
-    suds: bool
-    tags: frozenset[str]
-
-
-def _learner(family: str, suds: bool, *tags: str, name: str | None = None) -> LearnerInfo:
-    name = name or family + (SUDS_SUFFIX if suds else "")
-    return LearnerInfo(name, family, suds, frozenset(tags))
-
-
-#: The multi-layer perceptron the paper's Future Work compares with GMR (the survey's
-#: default learner to compare).
-MLP = "MLP"
-#: All named learners, in display order (the paper's five in its order first).
-REGISTRY: tuple[LearnerInfo, ...] = (
-    _learner("phase-only", False, "paper", "survey"),
-    _learner("TLS", False, "paper", "survey"),
-    _learner("TLS", True, "paper", "survey"),
-    _learner("GMR", False, "paper", "survey"),
-    _learner("GMR", True, "paper", "survey"),
-    _learner(MLP, False, "baseline", "survey"),
-    _learner(MLP, True, "baseline", "survey"),
-    _learner("GBT", False, "baseline", "survey"),
-    _learner("GBT", True, "baseline"),
-    _learner("kNN", False, "baseline", "survey"),
-    _learner("kNN", True, "baseline"),
-    _learner("KRR", False, "baseline", "survey"),
-    _learner("KRR", True, "baseline"),
-    _learner("GMR", False, "online", name="OnlineGMR"),
-    _learner("GMR", True, "online", name="OnlineGMR+SUDS"),
-    _learner("GMR", True, "online", name="GradualGMR+SUDS"),
-    # the paper's Future Work: a low-dimensional momentum state (models/momentum.py)
-    _learner("GMR", False, name="GMR" + MOMENTUM_SUFFIX),
-    _learner("GMR", True, name="GMR" + SUDS_SUFFIX + MOMENTUM_SUFFIX),
-    # and a map homogeneous but not linear in the shape velocity (models/finsler.py, models/tls_finsler.py)
-    _learner("GMR", False, name="GMR" + FINSLER_SUFFIX),
-    _learner("TLS", False, name="TLS" + FINSLER_SUFFIX),
+from suds_exp.vocabulary import (
+    ADAPTER,
+    BASELINE_LEARNERS,
+    BY_NAME,
+    FINSLER_LEARNERS,
+    FINSLER_SUFFIX,
+    GMR,
+    GMR_SUDS,
+    LEARNERS,
+    MLP,
+    MOMENTUM_LEARNERS,
+    MOMENTUM_SUFFIX,
+    ONLINE_LEARNERS,
+    PHASE_ONLY,
+    REGISTRY,
+    SUDS_SUFFIX,
+    SURVEY_LEARNERS,
+    TAGS,
+    TLS,
+    TLS_SUDS,
+    LearnerInfo,
+    tagged,
 )
-BY_NAME = {info.name: info for info in REGISTRY}
 
-
-def tagged(tag: str) -> tuple[str, ...]:
-    """Names of the learners tagged ``tag`` (one of `TAGS`), in `REGISTRY` order."""
-    if tag not in TAGS:
-        raise ValueError(f"tag {tag!r}: expected one of {', '.join(TAGS)}")
-    return tuple(info.name for info in REGISTRY if tag in info.tags)
-
-
-#: The paper's learners, in its order (`suds_exp.models.make_model` builds each).
-LEARNERS = tagged("paper")
-#: ``models="survey"``: the paper's five and the survey's scikit-learn baselines.
-SURVEY_LEARNERS = tagged("survey")
-#: Learners with `partial_fit(samples)`.
-ONLINE_LEARNERS = tagged("online")
-#: The named scikit-learn baselines, each with and without SUDS.
-BASELINE_LEARNERS = tagged("baseline")
-#: Learners with a momentum state (`models.momentum`): untagged, in `REGISTRY` order.
-MOMENTUM_LEARNERS = tuple(i.name for i in REGISTRY if i.name.endswith(MOMENTUM_SUFFIX))
-#: Learners whose map is homogeneous but not linear in the shape velocity.
-FINSLER_LEARNERS = tuple(i.name for i in REGISTRY if i.name.endswith(FINSLER_SUFFIX))
-#: The paper's five by role, for code that compares them (findings, synthetic results).
-PHASE_ONLY, TLS, TLS_SUDS, GMR, GMR_SUDS = LEARNERS
+__all__ = [
+    "ADAPTER",
+    "BASELINE_LEARNERS",
+    "BY_NAME",
+    "FINSLER_LEARNERS",
+    "FINSLER_SUFFIX",
+    "GMR",
+    "GMR_SUDS",
+    "LEARNERS",
+    "MLP",
+    "MOMENTUM_LEARNERS",
+    "MOMENTUM_SUFFIX",
+    "ONLINE_LEARNERS",
+    "PHASE_ONLY",
+    "REGISTRY",
+    "SUDS_SUFFIX",
+    "SURVEY_LEARNERS",
+    "TAGS",
+    "TLS",
+    "TLS_SUDS",
+    "LearnerInfo",
+    "tagged",
+]

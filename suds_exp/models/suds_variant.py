@@ -10,9 +10,12 @@ from __future__ import annotations
 import pandas as pd
 
 from suds_exp.models.base import ModelError, check_choice, passive_columns
+from suds_exp.models.params import Options, Param
 
 #: How a SUDS variant gets r_p at predict time.
 MODES = ("measured", "rollout")
+#: What a SUDS variant adds to its learner's hyper-parameters.
+SUDS_PARAMETERS = {"mode": Param("measured", Options(MODES))}
 
 
 def check_mode(mode: str, model: str) -> str:

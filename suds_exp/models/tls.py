@@ -47,13 +47,12 @@ from suds_exp.models.base import (
     TimeSeries,
     actuated_columns,
     as_array,
-    check_float,
-    check_int,
     phase_rate,
     require_columns,
     rollout_bounds,
 )
-from suds_exp.models.suds_variant import check_mode, required_passive_columns
+from suds_exp.models.params import Integer, Param, Real
+from suds_exp.models.suds_variant import SUDS_PARAMETERS, check_mode, required_passive_columns
 from suds_exp.robot import VB_COLUMNS
 
 _TWO_PI = 2.0 * np.pi
@@ -180,26 +179,16 @@ class TLS(Learner):
     """
 
     name = "TLS"
-
-    def __init__(
-        self,
-        n_bins: int = 16,
-        bin_width: float = 1.5,
-        gait_order: int = fourier.PHASE_ORDER,
-        coef_order: int = 3,
-        min_bin_factor: float = 2.0,
-        tls_gap: float = 2.0,
-        min_spread: float = 0.05,
-        ridge: float = 0.0,
-    ):
-        self.n_bins = n_bins
-        self.bin_width = bin_width
-        self.gait_order = gait_order
-        self.coef_order = coef_order
-        self.min_bin_factor = min_bin_factor
-        self.tls_gap = tls_gap
-        self.min_spread = min_spread
-        self.ridge = ridge
+    _hyper_parameters = {
+        "n_bins": Param(16, Integer(1)),
+        "bin_width": Param(1.5, Real(0.0, strict=True)),
+        "gait_order": Param(fourier.PHASE_ORDER, Integer(0)),
+        "coef_order": Param(3, Integer(0)),
+        "min_bin_factor": Param(2.0, Real(1.0)),
+        "tls_gap": Param(2.0, Real(1.0, strict=True)),
+        "min_spread": Param(0.05, Real(0.0)),
+        "ridge": Param(0.0, Real(0.0)),
+    }
 
     # -- columns -------------------------------------------------------------------
     def _shape_columns(self, samples):
@@ -209,14 +198,8 @@ class TLS(Learner):
         return list(VB_COLUMNS)
 
     def _validate(self):
-        nb = check_int("n_bins", self.n_bins, 1, self.name)
-        check_float("bin_width", self.bin_width, 0.0, self.name, strict=True)
-        check_int("gait_order", self.gait_order, 0, self.name)
-        co = check_int("coef_order", self.coef_order, 0, self.name)
-        check_float("min_bin_factor", self.min_bin_factor, 1.0, self.name)
-        check_float("tls_gap", self.tls_gap, 1.0, self.name, strict=True)
-        check_float("min_spread", self.min_spread, 0.0, self.name)
-        check_float("ridge", self.ridge, 0.0, self.name)
+        super()._validate()
+        nb, co = int(self.n_bins), int(self.coef_order)
         if 2 * co + 1 > nb:
             raise ConfigError(
                 f"{self.name}: coef_order={co} needs n_bins >= {2 * co + 1}, got n_bins={nb}"
@@ -371,27 +354,7 @@ class TLSSuds(TLS):
 
     name = "TLS+SUDS"
     suds = True
-
-    def __init__(
-        self,
-        n_bins: int = 16,
-        bin_width: float = 1.5,
-        gait_order: int = fourier.PHASE_ORDER,
-        coef_order: int = 3,
-        min_bin_factor: float = 2.0,
-        tls_gap: float = 2.0,
-        min_spread: float = 0.05,
-        ridge: float = 0.0,
-        mode: str = "measured",
-    ):
-        super().__init__(
-            n_bins, bin_width, gait_order, coef_order, min_bin_factor, tls_gap, min_spread, ridge
-        )
-        self.mode = mode
-
-    def _validate(self):
-        super()._validate()
-        check_mode(self.mode, self.name)
+    _hyper_parameters = TLS._hyper_parameters | SUDS_PARAMETERS
 
     def _shape_columns(self, samples):
         rp, drp = required_passive_columns(samples, self.name)

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import duckdb
 
 from suds_exp.errors import StoreError
+from suds_exp.store.vocabulary import sync_learners
 
 if TYPE_CHECKING:  # a reader checks the migrations without loading SQLAlchemy
     import sqlalchemy as sa
@@ -145,7 +146,9 @@ def apply(engine: sa.Engine, migrations: list[Migration], target: int | None = N
 def apply_on(
     conn: sa.Connection, migrations: list[Migration], target: int | None = None
 ) -> list[str]:
-    """`apply` on an open connection outside a transaction (left outside one)."""
+    """`apply` on an open connection outside a transaction (left outside one); brought
+    fully up to date (``target`` None), the ``learners`` table is then the registry's
+    (`suds_exp.store.vocabulary`)."""
     import sqlalchemy as sa
 
     migrations = [m for m in migrations if target is None or m.version <= target]
@@ -169,4 +172,6 @@ def apply_on(
                 {"v": m.version, "n": m.name, "c": m.checksum},
             )
         applied.append(m.name)
+    if target is None:
+        sync_learners(conn)
     return applied
