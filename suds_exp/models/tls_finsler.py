@@ -38,9 +38,9 @@ from suds_exp.models.base import (
     ModelError,
     actuated_columns,
     as_array,
-    check_choice,
     require_columns,
 )
+from suds_exp.models.params import Options, Param
 from suds_exp.models.tls import TLS, tls_solve
 from suds_exp.robot import VB_COLUMNS
 
@@ -109,26 +109,7 @@ class TLSFinsler(TLS):
 
     name = "TLS+F"
 
-    def __init__(
-        self,
-        n_bins: int = 16,
-        bin_width: float = 1.5,
-        gait_order: int = fourier.PHASE_ORDER,
-        coef_order: int = 3,
-        min_bin_factor: float = 2.0,
-        tls_gap: float = 2.0,
-        min_spread: float = 0.05,
-        ridge: float = 0.0,
-        split: bool = True,
-    ):
-        super().__init__(
-            n_bins, bin_width, gait_order, coef_order, min_bin_factor, tls_gap, min_spread, ridge
-        )
-        self.split = split
-
-    def _validate(self):
-        super()._validate()
-        check_choice("split", self.split, (True, False), self.name)
+    _hyper_parameters = TLS._hyper_parameters | {"split": Param(True, Options((True, False)))}
 
     def fit(self, samples: pd.DataFrame, y=None):
         self._validate()
