@@ -35,24 +35,24 @@ from threadpoolctl import threadpool_limits
 
 from suds_exp.analysis.categories import main_cycles
 from suds_exp.analysis.findings_view import (  # the table as shown; also read from here
-    VERDICTS as VERDICTS,
-)
-from suds_exp.analysis.findings_view import (
-    findings_display as findings_display,
-)
-from suds_exp.analysis.findings_view import (
-    findings_headline as findings_headline,
-)
-from suds_exp.analysis.findings_view import (
-    findings_json as findings_json,
-)
-from suds_exp.analysis.findings_view import (
-    findings_summary as findings_summary,
+    DESIGN_CAVEAT,
+    VERDICTS,
+    findings_display,
+    findings_headline,
+    findings_json,
+    findings_summary,
+    for_design,
 )
 from suds_exp.analysis.glm import formula_design, glm_formulas, glm_frame
 from suds_exp.errors import AnalysisError
 from suds_exp.experiment import is_paper
 from suds_exp.models.registry import LEARNERS
+
+__all__ = [
+    "DESIGN_CAVEAT", "FEW_CYCLES", "FINDINGS", "FINDINGS_COLUMNS", "VERDICTS", "Finding",
+    "NotMeasurable", "findings", "findings_display", "findings_headline", "findings_json",
+    "findings_summary", "findings_table", "for_design",
+]  # fmt: skip
 
 #: The learners' roles in the findings (names as stored in ``results.model``).
 PHASE, TLS, TLSS, GMR, GMRS = LEARNERS
@@ -661,12 +661,6 @@ def _row(
 
 
 #: What the findings say on a design other than the paper's (``{source}``: its file).
-DESIGN_CAVEAT = (
-    "F1-F10 assume the paper's design (its gaits S+ < S- < O < D- < D+ and frequencies); "
-    "{source} is another, so only the statistics its results can measure are shown"
-)
-
-
 def findings(store, campaign: str, design=None, **kwargs) -> pd.DataFrame:
     """`findings_table` of campaign ``campaign`` in ``store`` (keyword options as there,
     except that ``n_boot`` must be >= 1: a verdict needs its interval). ``design``: the
@@ -692,18 +686,3 @@ def findings(store, campaign: str, design=None, **kwargs) -> pd.DataFrame:
     if is_paper(design.declared()):
         source = f"{source} with {len(design.added_labels)} added level(s)"
     return for_design(table, source)
-
-
-def for_design(table: pd.DataFrame, source: str) -> pd.DataFrame:
-    """The findings ``table`` on a design other than the paper's (named ``source``):
-    only the statistics that could be measured, with ``attrs`` ``design`` (``source``),
-    ``caveat`` (`DESIGN_CAVEAT`) and ``left_out`` (``"<id>: <why>"`` for each other)."""
-    measured = table["verdict"] != "not measurable"
-    out = table[measured].reset_index(drop=True)
-    out.attrs = {
-        **table.attrs,
-        "design": source,
-        "caveat": DESIGN_CAVEAT.format(source=source),
-        "left_out": [f"{r.id}: {r.reason}" for r in table[~measured].itertuples()],
-    }
-    return out

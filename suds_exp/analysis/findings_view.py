@@ -78,3 +78,24 @@ def findings_json(table: pd.DataFrame, campaign: str) -> dict:
         "findings": findings_summary(table).to_dict(orient="records"),
         "statistics": rows,
     }
+
+
+DESIGN_CAVEAT = (
+    "F1-F10 assume the paper's design (its gaits S+ < S- < O < D- < D+ and frequencies); "
+    "{source} is another, so only the statistics its results can measure are shown"
+)
+
+
+def for_design(table: pd.DataFrame, source: str) -> pd.DataFrame:
+    """The findings ``table`` on a design other than the paper's (named ``source``):
+    only the statistics that could be measured, with ``attrs`` ``design`` (``source``),
+    ``caveat`` (`DESIGN_CAVEAT`) and ``left_out`` (``"<id>: <why>"`` for each other)."""
+    measured = table["verdict"] != "not measurable"
+    out = table[measured].reset_index(drop=True)
+    out.attrs = {
+        **table.attrs,
+        "design": source,
+        "caveat": DESIGN_CAVEAT.format(source=source),
+        "left_out": [f"{r.id}: {r.reason}" for r in table[~measured].itertuples()],
+    }
+    return out
