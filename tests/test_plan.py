@@ -98,10 +98,10 @@ def test_the_map_criterion_discounts_what_is_recorded_and_spreads_a_batch(small)
 
     blind = recommend_map(ensemble, target, 10, n=15)
     seen = recommend_map(ensemble, target, 10, n=15, samples=samples)
-    # the same variance, but the ten recorded cycles of O near the target's paths take a
-    # share of what any new trial there would remove
-    assert 0 < seen[0].score < blind[0].score
-    assert "cycles are recorded on average" in seen[0].reason
+    # without the recorded data O is worth recording again; with its ten cycles near the
+    # target's paths (and the bias left where they do not reach) another path is worth more
+    assert blind[0].score > 0 and "cycles are recorded on average" in seen[0].reason
+    assert seen[0].trial.gait.name != "O"
     # a batch: fifteen different trials, each scored as if the ones before were recorded
     picks = [(r.trial.gait.name, r.trial.frequency_hz) for r in seen]
     assert len(set(picks)) == 15
@@ -285,3 +285,36 @@ def test_run_after_a_map_loop_leaves_out_only_what_the_loop_recorded(tmp_path):
     ok("preprocess", "--db", str(db), "-q")
     r = runner.invoke(app, ["run", "m2", *args])
     assert r.exit_code != 0 and "skip-infeasible" in r.stderr
+
+
+@pytest.fixture(scope="module")
+def three_paths(tmp_path_factory) -> Path:
+    """O, D- and S- at 1/2 Hz, one trial of 10 cycles each, preprocessed (version v1)."""
+    work = tmp_path_factory.mktemp("plan-three")
+    db = work / "three.duckdb"
+    ok(
+        "simulate", "--out", str(work / "d"), "--gaits", "O,D-,S-", "--freqs", "1/2",
+        "--repeats", "1", "--cycles", "10", "--ingest", "--db", str(db), "-q",
+    )  # fmt: skip
+    ok("preprocess", "--db", str(db), "-q")
+    return db
+
+
+def test_the_map_criterion_prefers_a_path_no_data_covers(three_paths):
+    from suds_exp.plan import MapEnsemble
+    from suds_exp.plan.recommend import bias_variance, recommend_map
+    from suds_exp.preprocess import get_version
+
+    samples = get_version(Store(three_paths), "v1").samples()
+    ensemble = MapEnsemble.fit(samples, n_boot=3, seed=0)
+    target = Target()
+    # the bootstrap sees the noise of the three recorded paths, not the map's bias between
+    # them: the path jackknife (the target predicted by maps each fitted without one
+    # recorded path) is what makes a path not yet recorded worth recording
+    bias = bias_variance(samples, target)
+    assert bias.shape == (5,) and np.all(bias > 0)
+    (first,) = recommend_map(ensemble, target, 10, samples=samples)
+    assert first.trial.gait.name in ("D+", "S+"), first.reason
+    assert "bias between paths" in first.reason
+    batch = recommend_map(ensemble, target, 10, n=2, samples=samples)
+    assert {r.trial.gait.name for r in batch} == {"D+", "S+"}

@@ -84,7 +84,7 @@ def plan_next(
     ensemble = MapEnsemble.fit(samples, learner, n_boot, key)
     advice = Advice(version.id, goal, version_cycles(samples))
     if goal == "map":
-        advice.recommendations = recommend_map(ensemble, target, cycles, n, samples)
+        advice.recommendations = recommend_map(ensemble, target, cycles, n, samples, learner)
     else:
         out = Path(out)
         name = f"plan-v{version.id}-{key % 10**6:06d}.toml"

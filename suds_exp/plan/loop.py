@@ -425,7 +425,9 @@ def _plan(state: _State, opts: LoopOptions, target: Target, trust: float, folder
             max_evals=opts.max_evals,
         )
     else:
-        rec = recommend_map(state.ensemble, target, opts.cycles, samples=state.samples)[0]
+        rec = recommend_map(
+            state.ensemble, target, opts.cycles, samples=state.samples, learner=opts.learner
+        )[0]
     folder.mkdir(parents=True, exist_ok=True)
     if isinstance(rec.trial.gait, FourierGait) and rec.trial.file:
         (folder / rec.trial.file).write_text(rec.trial.gait.to_toml())
