@@ -48,13 +48,13 @@ import pandas as pd
 from scipy.spatial import cKDTree
 
 from suds_exp.gait.design import circle, optimise_gait
-from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, NamedGait, paper_gaits, within_bound
 from suds_exp.gait.predict import fit_map
+from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, paper_gaits, within_bound
 from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns, direction_features
 from suds_exp.models.registry import GMR
 from suds_exp.plan.ensemble import MapEnsemble
 from suds_exp.plan.target import Target
-from suds_exp.robot import FREQUENCIES_HZ, GAITS
+from suds_exp.robot import FREQUENCIES_HZ
 
 #: Weight of the bootstrap spread in the gait goal's upper confidence bound.
 KAPPA = 1.0
@@ -181,7 +181,8 @@ def recorded_paths(samples: pd.DataFrame | None) -> list[tuple[str, float]]:
     if samples is None or samples.empty:
         return []
     pairs = samples[["gait", "frequency_hz"]].drop_duplicates()
-    return sorted(zip(pairs["gait"].astype(str), pairs["frequency_hz"].astype(float)))
+    labels, freqs = pairs["gait"].astype(str), pairs["frequency_hz"].astype(float)
+    return sorted(zip(labels, freqs, strict=True))
 
 
 def paths_worth(paths: list[tuple[str, float]], frequency_hz: float) -> float:
