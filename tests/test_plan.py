@@ -273,6 +273,14 @@ def test_run_report_and_findings_work_on_the_version_after_a_gait_loop(gait_loop
 def test_run_after_a_map_loop_leaves_out_only_what_the_loop_recorded(tmp_path):
     db = tmp_path / "m.duckdb"
     run_loop(Store(db), tiny(goal="map", budget_cycles=13, seed=2), out=tmp_path / "o")
+    with Store(db).write() as conn:
+        marked = conn.exec_driver_sql(
+            "SELECT count(*) = (SELECT count(*) FROM trials) FROM trials_added "
+            "WHERE added_by LIKE 'plan loop plan-%'"
+        ).scalar()
+        assert marked  # every trial the loop recorded, its warm-up included
+        # the campaign knows the loop's trials from the data alone, not from plan tables
+        conn.exec_driver_sql("DROP TABLE plan_iterations")
     args = ("--models", "GMR", "--boots", "1", "--train-cycles", "3", "--db", str(db))
     out = ok("run", "m", *args, "-q")
     assert "left out:" in out
@@ -318,3 +326,17 @@ def test_the_map_criterion_prefers_a_path_no_data_covers(three_paths):
     assert "bias between paths" in first.reason
     batch = recommend_map(ensemble, target, 10, n=2, samples=samples)
     assert {r.trial.gait.name for r in batch} == {"D+", "S+"}
+
+
+def test_the_stopping_signal_needs_two_verdicts_and_does_not_flicker():
+    from suds_exp.plan.curve import StopSignal, latched
+
+    def verdict(stop: bool) -> StopSignal:
+        return StopSignal(stop, "stop: x" if stop else "continue: x", [8.0, 16.0], [], [], None)
+
+    said, before, fired = [], None, False
+    for stop in (True, False, True, True, False, True):
+        signal = latched(verdict(stop), before, fired)
+        before, fired = verdict(stop), fired or signal.stop
+        said.append(signal.stop)
+    assert said == [False, False, False, True, True, True]

@@ -41,6 +41,7 @@ from suds_exp.gait.shape import FourierGait, Gait, NamedGait, read_gait_file
 from suds_exp.gait.support import Support
 from suds_exp.gait.truth import simulate_gaits
 from suds_exp.ingest import stored_design, trial_level_axis
+from suds_exp.ingest.added import mark_trials_added
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
 from suds_exp.plan.curve import latched, learning_curve, target_signal
@@ -332,6 +333,7 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
             warm = Trial(NamedGait(opts.warmup_gait), opts.warmup_frequency_hz, opts.warmup_cycles)
             seed = derive_seed("plan-record", name, 0) % 2**31
             trial_id = record_trial(store, warm, folder / "it0", seed, config)
+            mark_trials_added(store, [trial_id], f"plan loop {name}")
             run_preprocess(store, trials=[trial_id], progress=False)
             version = get_version(store)
             check_body(version)
