@@ -340,3 +340,16 @@ def test_the_stopping_signal_needs_two_verdicts_and_does_not_flicker():
         before, fired = verdict(stop), fired or signal.stop
         said.append(signal.stop)
     assert said == [False, False, False, True, True, True]
+
+
+def test_a_recorded_path_at_one_third_hz_is_known_as_recorded():
+    import pandas as pd
+
+    from suds_exp.plan.recommend import declared_levels, recorded_paths
+
+    # stored frequencies have 6 decimals; the declared level is 1/3 exactly
+    frame = pd.DataFrame({"gait": ["O", "O", "D-"], "frequency_hz": [0.333333, 0.333333, 0.5]})
+    paths = recorded_paths(frame)
+    assert paths == [("D-", 0.5), ("O", 0.333333)]
+    levels = {(g.name, round(f, 6)) for g, f in declared_levels()}
+    assert set(paths) <= levels

@@ -143,7 +143,8 @@ def candidate_spacing(gaits: list[Gait], n: int = 64) -> float:
 
 
 def _frequency_weight(a: float, b: float) -> float:
-    return 1.0 if math.isclose(a, b) else OTHER_FREQUENCY_WEIGHT
+    # frequencies as stored (6 decimals): 1/3 Hz planned is 0.333333 recorded
+    return 1.0 if round(a, 6) == round(b, 6) else OTHER_FREQUENCY_WEIGHT
 
 
 def recorded_cycles_near(
@@ -181,8 +182,14 @@ def recorded_paths(samples: pd.DataFrame | None) -> list[tuple[str, float]]:
     if samples is None or samples.empty:
         return []
     pairs = samples[["gait", "frequency_hz"]].drop_duplicates()
-    labels, freqs = pairs["gait"].astype(str), pairs["frequency_hz"].astype(float)
-    return sorted(zip(labels, freqs, strict=True))
+    labels = pairs["gait"].astype(str)
+    freqs = [_path_hz(f) for f in pairs["frequency_hz"].astype(float)]
+    return sorted(set(zip(labels, freqs, strict=True)))
+
+
+def _path_hz(frequency_hz: float) -> float:
+    # a path's frequency as stored (6 decimals), so 1/3 Hz planned is 0.333333 recorded
+    return round(float(frequency_hz), 6)
 
 
 def paths_worth(paths: list[tuple[str, float]], frequency_hz: float) -> float:
@@ -270,7 +277,7 @@ def recommend_map(
                 continue
             noise[i] = float(np.sum(per_sample * m / (PRIOR_CYCLES + recorded + m)))
             gait, freq = candidates[i]
-            if (gait.name, freq) not in covered and worth.min() > 0:
+            if (gait.name, _path_hz(freq)) not in covered and worth.min() > 0:
                 w = np.array([_frequency_weight(freq, f) for _, f in pairs])
                 between[i] = float(np.sum(bias * w / (worth + w)))
         removed = noise + between
@@ -291,10 +298,10 @@ def recommend_map(
         # the next pick is scored as if this one were recorded
         per_sample = per_sample * (PRIOR_CYCLES + recorded) / (PRIOR_CYCLES + recorded + m)
         recorded = recorded + m
-        if (gait.name, freq) not in covered and worth.min() > 0:
+        if (gait.name, _path_hz(freq)) not in covered and worth.min() > 0:
             w = np.array([_frequency_weight(freq, f) for _, f in pairs])
             bias = bias * worth / (worth + w)
-            covered = covered + [(gait.name, freq)]
+            covered = covered + [(gait.name, _path_hz(freq))]
         taken.add(i)
     return recs
 
