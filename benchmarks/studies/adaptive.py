@@ -57,7 +57,8 @@ from suds_exp.gait.trials import gait_trial_specs
 from suds_exp.gait.truth import simulate_forward
 from suds_exp.ingest import ingest_paths
 from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop
-from suds_exp.plan.ensemble import block_draws
+from suds_exp.plan.curve import latched, target_signal
+from suds_exp.plan.ensemble import MapEnsemble, block_draws
 from suds_exp.plan.recommend import Trial
 from suds_exp.plan.record import record_trial
 from suds_exp.preprocess import get_version, preprocess
@@ -156,10 +157,20 @@ def arm_plan(
     if truth is not None:
         samples = get_version(store, loop.prep_version).samples()
         trial_ids = [it.trial_id for it in loop.iterations]
+        before, fired = None, False
         for k, row in enumerate(rows):
             part = samples[samples["trial_id"].isin(trial_ids[: k + 1])]
             key = derive_seed("flat", seed, k)
             row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
+            # the stopping signal as the library computes it now, from the stored data
+            # (the loop's own ensemble seeds), whatever the loop stored when it ran
+            ens = MapEnsemble.fit(
+                part, opts.learner, opts.n_boot, derive_seed("plan-fit", loop.name, k)
+            )
+            now = target_signal(part, ens, truth.target, opts.learner)
+            signal = now if k == 0 else latched(now, before, fired)
+            before, fired = now, fired or signal.stop
+            row["stop"], row["stop_reason"] = bool(signal.stop), signal.message
     return rows
 
 

@@ -34,12 +34,10 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 import pandas as pd
-import sqlalchemy as sa
 from threadpoolctl import threadpool_limits
 
 from suds_exp.campaign import tables
 from suds_exp.campaign.bank import SampleBank, rounded_conditions
-from suds_exp.campaign.conditions import round_hz
 from suds_exp.campaign.definition import (
     CampaignOptions,
     Plan,
@@ -55,6 +53,7 @@ from suds_exp.campaign.sampling import check_feasible
 from suds_exp.display import Summary
 from suds_exp.errors import CampaignError, ClusterLostError, StoreError
 from suds_exp.ingest import stored_design
+from suds_exp.ingest.added import added_conditions
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
 from suds_exp.store.definition import check_same
@@ -219,7 +218,7 @@ def run_campaign(
             dataclasses.replace(merged, prep=prep),
             stored,
             samples,
-            stored_design(store).added_labels | planned_conditions(store),
+            stored_design(store).added_labels | added_conditions(store),
         )
         n_workers = _n_workers(jobs)
         chunks, total, pending = pending_jobs(
@@ -294,31 +293,6 @@ def campaign_samples(
 
     version = get_version(store, prep)
     return version.name, version.samples()
-
-
-def planned_conditions(store: Store) -> frozenset:
-    """The (gait, frequency_hz) conditions every trial of which a planning loop chose and
-    recorded (``plan_iterations.trial_id``: its warm-up and its trials of declared
-    levels); empty for a store without plan loops."""
-    with store.read() as conn:
-        have = conn.execute(
-            sa.text(
-                "SELECT count(*) FROM information_schema.tables "
-                "WHERE table_name = 'plan_iterations'"
-            )
-        ).scalar()
-        if not have:
-            return frozenset()
-        frame = Store.frame(
-            conn,
-            "SELECT t.gait, t.frequency_hz, bool_and(p.trial_id IS NOT NULL) AS planned "
-            "FROM trials t LEFT JOIN (SELECT DISTINCT trial_id FROM plan_iterations) p "
-            "ON p.trial_id = t.id WHERE t.gait IS NOT NULL AND t.frequency_hz IS NOT NULL "
-            "GROUP BY t.gait, t.frequency_hz",
-        )
-    return frozenset(
-        (str(r.gait), round_hz(r.frequency_hz)) for r in frame.itertuples() if r.planned
-    )
 
 
 def plan_campaign(

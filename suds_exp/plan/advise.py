@@ -11,7 +11,7 @@ from suds_exp.gait.predict import derive_seed
 from suds_exp.gait.support import Support
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
-from suds_exp.plan.curve import StopSignal, learning_curve
+from suds_exp.plan.curve import StopSignal, learning_curve, target_signal
 from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
 from suds_exp.plan.loop import TRUST0, _recorded_gaits, check_body, version_cycles
 from suds_exp.plan.recommend import Recommendation, recommend_gait, recommend_map
@@ -84,7 +84,7 @@ def plan_next(
     ensemble = MapEnsemble.fit(samples, learner, n_boot, key)
     advice = Advice(version.id, goal, version_cycles(samples))
     if goal == "map":
-        advice.recommendations = recommend_map(ensemble, target, cycles, n, samples)
+        advice.recommendations = recommend_map(ensemble, target, cycles, n, samples, learner)
     else:
         out = Path(out)
         name = f"plan-v{version.id}-{key % 10**6:06d}.toml"
@@ -103,5 +103,8 @@ def plan_next(
         rec.trial.file = str(path)
         advice.recommendations = [rec]
         advice.files = [str(path)]
-    advice.stop = learning_curve(samples, learner, key)
+    if goal == "map":
+        advice.stop = target_signal(samples, ensemble, target, learner)
+    else:
+        advice.stop = learning_curve(samples, learner, key)
     return advice

@@ -10,6 +10,14 @@ folds; its spread is the standard error of that mean across the folds.
 The signal is plain: if the last doubling of cycles lowered the held-out error by less
 than its spread, the next doubling (of the same kind of data) will not help more, since
 a learning curve flattens as it goes; say so.
+
+For the map goal the doubling is judged on the target itself (`target_signal`): the
+map fitted on the first half of the recorded cycles and the map fitted on all of them
+predict the target's net displacement per cycle; if the last doubling moved those
+predictions by less than their bootstrap spread, the data of the second half did not
+teach the map anything about the target it could tell from noise. The loop says stop
+once this holds at two successive iterations and keeps saying it (`latched`), so one
+lucky refit neither fires it nor a later one unfires it.
 """
 
 from __future__ import annotations
@@ -21,7 +29,8 @@ import pandas as pd
 
 from suds_exp.gait.predict import fit_map
 from suds_exp.models.registry import GMR
-from suds_exp.plan.ensemble import cycle_blocks
+from suds_exp.plan.ensemble import MapEnsemble, cycle_blocks
+from suds_exp.plan.target import Target
 
 N_FOLDS = 4
 #: Fewest cycle blocks the curve is drawn from (two per fold, so the smallest training
@@ -42,13 +51,19 @@ class StopSignal:
     error_mm_s: list[float]
     spread_mm_s: list[float]
     last_drop_mm_s: float | None
+    change_mm: float | None = None
+    spread_mm: float | None = None
 
     def to_dict(self) -> dict:
         out = asdict(self)
         for key in ("cycles", "error_mm_s", "spread_mm_s"):
             out[key] = [round(float(v), 4) for v in out[key]]
-        if self.last_drop_mm_s is not None:
-            out["last_drop_mm_s"] = round(float(self.last_drop_mm_s), 4)
+        for key in ("last_drop_mm_s", "change_mm", "spread_mm"):
+            if out[key] is not None:
+                out[key] = round(float(out[key]), 4)
+        for key in ("change_mm", "spread_mm"):  # only the target's signal has them
+            if out[key] is None:
+                del out[key]
         return out
 
 
@@ -104,3 +119,71 @@ def learning_curve(samples: pd.DataFrame, learner: str = GMR, seed: int = 0) -> 
             f"held-out error by {drop:.2f} mm/s, more than its spread {spread[-1]:.2f} mm/s"
         )
     return StopSignal(stop, message, cycles, mean.tolist(), spread.tolist(), drop)
+
+
+def target_signal(
+    samples: pd.DataFrame, ensemble: MapEnsemble, target: Target, learner: str = GMR
+) -> StopSignal:
+    """The stopping signal judged on ``target`` (see the module docstring): the RMS over
+    the target's (gait, frequency) pairs of the change (mm) of the predicted net
+    displacement per cycle between the map fitted on the first half of the cycles
+    (recording order: trial id, then cycle) and ``ensemble.point`` (fitted on all of
+    them), against the RMS of ``ensemble``'s bootstrap standard deviation there (mm).
+    Needs `MIN_BLOCKS` cycles in the half."""
+    blocks = cycle_blocks(samples)
+    half = len(blocks) // 2
+    if half < MIN_BLOCKS:
+        return StopSignal(
+            False,
+            f"too few cycles to judge a doubling on the target ({len(blocks)} of "
+            f"{2 * MIN_BLOCKS}): record more",
+            [],
+            [],
+            [],
+            None,
+        )
+    first = fit_map(pd.concat(blocks[:half], ignore_index=True), learner)
+    sq = []
+    for g, f in target.pairs():
+        a, b = first.motion(g, f), ensemble.point.motion(g, f)
+        sq.append((a.forward_mm - b.forward_mm) ** 2 + (a.lateral_mm - b.lateral_mm) ** 2)
+    change = float(np.sqrt(np.mean(sq)))
+    variance = [ensemble.displacement_spread([g], f)[0] for g, f in target.pairs()]
+    spread = float(np.sqrt(np.mean(variance)))
+    doubling = f"the last doubling of cycles ({half} -> {len(blocks)})"
+    if change < spread:
+        stop, message = (
+            True,
+            (
+                f"stop: {doubling} moved the target's predictions by {change:.2f} mm per cycle, "
+                f"less than their bootstrap spread {spread:.2f} mm; more data of this kind "
+                "will not help"
+            ),
+        )
+    else:
+        stop, message = (
+            False,
+            (
+                f"continue: {doubling} moved the target's predictions by {change:.2f} mm per "
+                f"cycle, more than their bootstrap spread {spread:.2f} mm"
+            ),
+        )
+    return StopSignal(stop, message, [float(half), float(len(blocks))], [], [], None,
+                      change, spread)  # fmt: skip
+
+
+def latched(now: StopSignal, before: StopSignal | None, fired: bool) -> StopSignal:
+    """The signal a loop reports: stop once ``now`` and ``before`` (the previous
+    iteration's, None at the first) both say stop, and from then on (``fired``: a stored
+    iteration already said stop); otherwise ``now`` with stop False."""
+    if fired and not now.stop:
+        return StopSignal(True, "stop (said before; now " + now.message + ")", now.cycles,
+                          now.error_mm_s, now.spread_mm_s, now.last_drop_mm_s, now.change_mm,
+                          now.spread_mm)  # fmt: skip
+    if now.stop and (fired or (before is not None and before.stop)):
+        return now
+    if now.stop:
+        return StopSignal(False, "continue (once more to confirm): " + now.message, now.cycles,
+                          now.error_mm_s, now.spread_mm_s, now.last_drop_mm_s, now.change_mm,
+                          now.spread_mm)  # fmt: skip
+    return now

@@ -5,7 +5,8 @@ simulate with the trial's seed, ingest, preprocess into the version), refits the
 with its bootstrap refits, and stores one row of ``plan_iterations`` (migration 022):
 the trial and its reason, the cycles recorded so far, the map's error on the target set,
 the best recorded gait and its predicted and simulator-achieved forward displacement per
-cycle, the learning curve's stopping signal and the gait goal's trust radius.
+cycle, the stopping signal (the map goal's judged on the target and latched, the gait
+goal's the learning curve's: `suds_exp.plan.curve`) and the gait goal's trust radius.
 
 Budget: the cycles the loop records, its warm-up included. A loop starts from a warm-up
 recording (`LoopOptions.warmup_gait` at `warmup_frequency_hz`, `warmup_cycles` cycles)
@@ -40,9 +41,10 @@ from suds_exp.gait.shape import FourierGait, Gait, NamedGait, read_gait_file
 from suds_exp.gait.support import Support
 from suds_exp.gait.truth import simulate_gaits
 from suds_exp.ingest import stored_design, trial_level_axis
+from suds_exp.ingest.added import mark_trials_added
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
-from suds_exp.plan.curve import learning_curve
+from suds_exp.plan.curve import latched, learning_curve, target_signal
 from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
 from suds_exp.plan.recommend import Recommendation, Trial, recommend_gait, recommend_map
 from suds_exp.plan.record import add_trial_to_version, record_trial
@@ -213,7 +215,12 @@ class _State:
             achieved[self.best.name] = simulate_gaits([self.best], freq)[0].forward_mm
         self.best_achieved = float(achieved[self.best.name])
         self.map_error = truth.map_error(self.ensemble.point)
-        self.curve = learning_curve(self.samples, opts.learner, seed)
+        if opts.goal == "map":
+            self.curve = target_signal(self.samples, self.ensemble, target, opts.learner)
+        else:
+            self.curve = learning_curve(self.samples, opts.learner, seed)
+        # the iteration's own verdict, before the loop's latch (`latched`) reads it
+        self.raw_curve = self.curve
         self.cycles_total = version_cycles(self.samples)
 
 
@@ -326,6 +333,7 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
             warm = Trial(NamedGait(opts.warmup_gait), opts.warmup_frequency_hz, opts.warmup_cycles)
             seed = derive_seed("plan-record", name, 0) % 2**31
             trial_id = record_trial(store, warm, folder / "it0", seed, config)
+            mark_trials_added(store, [trial_id], f"plan loop {name}")
             run_preprocess(store, trials=[trial_id], progress=False)
             version = get_version(store)
             check_body(version)
@@ -372,8 +380,11 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
                 config,
                 added_by=f"plan loop {name}",
             )
-            before = state.best_predicted
+            before, signal_before = state.best_predicted, state.raw_curve
             state = _State(store, version, opts, target, truth, folder, name, it, achieved)
+            if opts.goal == "map":
+                fired = any(i.stop for i in loop.iterations)
+                state.curve = latched(state.raw_curve, signal_before, fired)
             if opts.goal == "gait":
                 trust = _next_trust(trust, rec, state, target, before)
             recorded += rec.trial.cycles
@@ -425,7 +436,9 @@ def _plan(state: _State, opts: LoopOptions, target: Target, trust: float, folder
             max_evals=opts.max_evals,
         )
     else:
-        rec = recommend_map(state.ensemble, target, opts.cycles, samples=state.samples)[0]
+        rec = recommend_map(
+            state.ensemble, target, opts.cycles, samples=state.samples, learner=opts.learner
+        )[0]
     folder.mkdir(parents=True, exist_ok=True)
     if isinstance(rec.trial.gait, FourierGait) and rec.trial.file:
         (folder / rec.trial.file).write_text(rec.trial.gait.to_toml())

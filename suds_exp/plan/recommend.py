@@ -23,7 +23,14 @@ Two goals:
   Why not the bootstrap alone: the cycle bootstrap sees the noise of what is recorded,
   not the bias of a map that has seen only a few paths (after 35 cycles of three gaits
   its variance over the default target was about 5 mm^2 against a squared error near
-  40 mm^2), so on its own it keeps choosing the paths nearest the target.
+  40 mm^2), so on its own it keeps choosing the paths nearest the target. The score
+  therefore adds a bias term: how much each target's prediction depends on which paths
+  were recorded, measured by the path jackknife (`bias_variance`: leave each recorded
+  (gait, frequency) out, refit, predict the target). Like a jackknife variance it falls
+  as 1/k in the k distinct paths recorded, so a trial on a new path removes the share
+  w / (k + w) of it (w = 1 at the target's frequency, `OTHER_FREQUENCY_WEIGHT` at
+  another) and a repeat of a recorded path removes none: more cycles of a path lower
+  the noise, not the bias between paths. The two terms add.
 - ``"gait"``: the best forward displacement per cycle within the bound. The next trial is
   a new Fourier gait (written to a file) that maximises the upper confidence bound
   (point prediction + `KAPPA` x bootstrap spread) inside the joint bound and inside a
@@ -41,8 +48,10 @@ import pandas as pd
 from scipy.spatial import cKDTree
 
 from suds_exp.gait.design import circle, optimise_gait
+from suds_exp.gait.predict import fit_map
 from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, paper_gaits, within_bound
 from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns, direction_features
+from suds_exp.models.registry import GMR
 from suds_exp.plan.ensemble import MapEnsemble
 from suds_exp.plan.target import Target
 from suds_exp.robot import FREQUENCIES_HZ
@@ -134,7 +143,8 @@ def candidate_spacing(gaits: list[Gait], n: int = 64) -> float:
 
 
 def _frequency_weight(a: float, b: float) -> float:
-    return 1.0 if math.isclose(a, b) else OTHER_FREQUENCY_WEIGHT
+    # frequencies as stored (6 decimals): 1/3 Hz planned is 0.333333 recorded
+    return 1.0 if round(a, 6) == round(b, 6) else OTHER_FREQUENCY_WEIGHT
 
 
 def recorded_cycles_near(
@@ -162,17 +172,79 @@ def recorded_cycles_near(
     return out
 
 
+def _displacement(fitted, gait: Gait, frequency_hz: float) -> np.ndarray:
+    m = fitted.motion(gait, frequency_hz)
+    return np.array([m.forward_mm, m.lateral_mm])
+
+
+def recorded_paths(samples: pd.DataFrame | None) -> list[tuple[str, float]]:
+    """The distinct (gait label, frequency Hz) of the recorded trials, sorted."""
+    if samples is None or samples.empty:
+        return []
+    pairs = samples[["gait", "frequency_hz"]].drop_duplicates()
+    labels = pairs["gait"].astype(str)
+    freqs = [_path_hz(f) for f in pairs["frequency_hz"].astype(float)]
+    return sorted(set(zip(labels, freqs, strict=True)))
+
+
+def _path_hz(frequency_hz: float) -> float:
+    # a path's frequency as stored (6 decimals), so 1/3 Hz planned is 0.333333 recorded
+    return round(float(frequency_hz), 6)
+
+
+def paths_worth(paths: list[tuple[str, float]], frequency_hz: float) -> float:
+    """The recorded paths' worth to a target at frequency_hz (Hz): one a distinct gait
+    at that frequency, `OTHER_FREQUENCY_WEIGHT` one at another frequency."""
+    return float(sum(_frequency_weight(f, frequency_hz) for _, f in paths))
+
+
+def bias_variance(
+    samples: pd.DataFrame | None, target: Target, learner: str = GMR, point=None
+) -> np.ndarray:
+    """The variance (mm^2, net displacement per cycle, forward and lateral together) of
+    each target's prediction over which paths were recorded: the path jackknife. Each
+    recorded path (`recorded_paths`: gait and frequency) is left out in turn, the
+    learner refitted without its trials, and the target predicted; the variance is
+    (k - 1) / k times the sum of the squared deviations of those k predictions from
+    their mean. With fewer than two paths there is nothing to leave out: the squared
+    displacement ``point`` (the `FittedMap` on all the samples; fitted here when None)
+    predicts for the target (a map that has seen one path errs elsewhere by the order
+    of the motion itself). Zeros without samples. Shape (len(target.pairs()),)."""
+    pairs = target.pairs()
+    paths = recorded_paths(samples)
+    if not paths:
+        return np.zeros(len(pairs))
+    if len(paths) < 2:
+        point = point if point is not None else fit_map(samples, learner)
+        return np.array([float(_displacement(point, g, f) @ _displacement(point, g, f))
+                         for g, f in pairs])  # fmt: skip
+    labels = samples["gait"].astype(str)
+    freqs = samples["frequency_hz"].astype(float)
+    preds = []
+    for label, f in paths:
+        held = (labels == label) & np.isclose(freqs, f)
+        without = fit_map(samples[~held], learner)
+        preds.append([_displacement(without, g, ft) for g, ft in pairs])
+    preds = np.array(preds)  # (k, targets, 2)
+    k = len(paths)
+    dev = preds - preds.mean(axis=0)
+    return (k - 1) / k * np.sum(dev**2, axis=(0, 2))
+
+
 def recommend_map(
     ensemble: MapEnsemble,
     target: Target,
     cycles: int,
     n: int = 1,
     samples: pd.DataFrame | None = None,
+    learner: str = GMR,
 ) -> list[Recommendation]:
     """The ``n`` trials of ``cycles`` cycles that remove the most prediction variance
-    integrated over the target's paths (see the module docstring), chosen greedily, in
-    that order. ``samples``: the recorded data (the version's frame) whose cycles near
-    each path sample discount a new trial's; None counts none."""
+    over the target (see the module docstring): the noise term integrated over the
+    target's paths plus the bias term, chosen greedily, in that order. ``samples``: the
+    recorded data (the version's frame) whose cycles near each path sample discount a
+    new trial's and whose paths give the bias term (refitted with ``learner``); None
+    counts none and adds no bias term."""
     pairs = target.pairs()
     n_path = 64
     variance = np.array([ensemble.displacement_spread([g], f)[0] for g, f in pairs])
@@ -184,6 +256,8 @@ def recommend_map(
     ]
     scale = candidate_spacing([g for g, _ in candidates], n_path)
     recorded = recorded_cycles_near(samples, target, n_path, scale)
+    bias = bias_variance(samples, target, learner, ensemble.point)
+    covered = recorded_paths(samples)
     paths = [_path_features(g, n_path) for g, _ in pairs]
     brings, reach = [], []
     for gait, freq in candidates:
@@ -195,29 +269,39 @@ def recommend_map(
     recs: list[Recommendation] = []
     taken: set[int] = set()
     for _ in range(min(n, len(candidates))):
-        removed = np.array(
-            [
-                float(np.sum(per_sample * m / (PRIOR_CYCLES + recorded + m)))
-                if i not in taken
-                else -np.inf
-                for i, m in enumerate(brings)
-            ]
-        )
+        noise = np.full(len(candidates), -np.inf)
+        between = np.zeros(len(candidates))
+        worth = np.array([paths_worth(covered, f) for _, f in pairs])
+        for i, m in enumerate(brings):
+            if i in taken:
+                continue
+            noise[i] = float(np.sum(per_sample * m / (PRIOR_CYCLES + recorded + m)))
+            gait, freq = candidates[i]
+            if (gait.name, _path_hz(freq)) not in covered and worth.min() > 0:
+                w = np.array([_frequency_weight(freq, f) for _, f in pairs])
+                between[i] = float(np.sum(bias * w / (worth + w)))
+        removed = noise + between
         i = int(np.argmax(removed))
         m = brings[i]
         near = recorded[m > 0.5 * m.max()]
         gait, freq = candidates[i]
-        covered = reach[i]
         reason = (
             f"expected to remove {removed[i]:.2f} mm^2 of the target's prediction variance "
-            f"of {per_sample.sum():.2f} ({covered} of {len(pairs)} targets visited, where "
-            f"{float(near.mean()) if near.size else 0.0:.1f} cycles are recorded on average)"
+            f"of {per_sample.sum() + bias.sum():.2f}: {noise[i]:.2f} of its noise "
+            f"(bootstrap) and {between[i]:.2f} of its bias between paths (path jackknife "
+            f"over {len(covered)} recorded paths; {reach[i]} of {len(pairs)} targets "
+            f"visited, where {float(near.mean()) if near.size else 0.0:.1f} cycles are "
+            "recorded on average)"
         )
         trial = Trial(gait, freq, cycles, _file_of(gait, target))
         recs.append(Recommendation(trial, float(removed[i]), "mm^2", reason))
         # the next pick is scored as if this one were recorded
         per_sample = per_sample * (PRIOR_CYCLES + recorded) / (PRIOR_CYCLES + recorded + m)
         recorded = recorded + m
+        if (gait.name, _path_hz(freq)) not in covered and worth.min() > 0:
+            w = np.array([_frequency_weight(freq, f) for _, f in pairs])
+            bias = bias * worth / (worth + w)
+            covered = covered + [(gait.name, _path_hz(freq))]
         taken.add(i)
     return recs
 

@@ -20,6 +20,7 @@ import sqlalchemy as sa
 from suds_exp.gait.shape import FourierGait
 from suds_exp.gait.trials import simulate_gait_file
 from suds_exp.ingest import add_trial_levels, ingest_paths
+from suds_exp.ingest.added import mark_trials_added
 from suds_exp.plan.recommend import Trial
 from suds_exp.preprocess import preprocess as run_preprocess
 from suds_exp.robot import GAITS
@@ -96,9 +97,11 @@ def add_trial_to_version(
     `suds_exp.preprocess.Version`) with the version's own parameters; its trial id.
 
     The one call site where a plan's trials become part of the data, and so of the
-    experiment's design: a gait file's trial (labelled with the file's name) becomes an
-    added level of the stored design, recorded as added by ``added_by``."""
+    experiment's design: the trial is marked as recorded by ``added_by``
+    (`mark_trials_added`), and a gait file's trial (labelled with the file's name) becomes
+    an added level of the stored design, recorded as added by ``added_by``."""
     trial_id = record_trial(store, trial, folder, seed, config)
+    mark_trials_added(store, [trial_id], added_by)
     if not is_declared(trial):
         add_trial_levels(store, {trial_id: trial.gait.name}, added_by=added_by)
     run_preprocess(store, version.name, params=version.params, trials=[trial_id], progress=False)
