@@ -257,6 +257,7 @@ class Learner(Summary, BaseEstimator):
         if "_hyper_parameters" in vars(cls) and "__init__" not in vars(cls):
             cls.__init__ = init_from(cls._hyper_parameters)
             cls.__init__.__qualname__ = f"{cls.__qualname__}.__init__"
+            cls.__init__.__module__ = cls.__module__
 
     def _validate_params(self) -> None:
         """Check every declared hyper-parameter (in declaration order); the first bad one
