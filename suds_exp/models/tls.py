@@ -129,6 +129,19 @@ def tls_solve(
     return ym - xm @ B, B, n_kept
 
 
+def bin_rows(wrapped: np.ndarray, centre: float, half: float, need_n: int):
+    """A phase bin's samples: ``off`` (n,), every sample's phase offset from ``centre``
+    (rad, in (-pi, pi]), and ``idx``, the samples within ``half`` of it, or the ``need_n``
+    nearest when fewer are (all of them if there are fewer samples)."""
+    off = np.angle(np.exp(1j * (wrapped - centre)))
+    d = np.abs(off)
+    idx = np.flatnonzero(d <= half)
+    if len(idx) < need_n:
+        k = min(need_n, len(d))
+        idx = np.argpartition(d, k - 1)[:k]
+    return off, idx
+
+
 def _features(delta: np.ndarray, ddot: np.ndarray) -> np.ndarray:
     """Regressors [delta, delta_dot_a, delta x delta_dot_a], shape (n, m + a + m*a)."""
     prod = (delta[:, :, None] * ddot[:, None, :]).reshape(len(delta), -1)
@@ -281,11 +294,7 @@ class TLS(Learner):
         bin_coef = np.empty((self.n_bins, p + 1, q))
         n_kept = 0
         for b, c in enumerate(centres):
-            off = np.angle(np.exp(1j * (wrapped - c)))
-            d = np.abs(off)
-            idx = np.flatnonzero(d <= half)
-            if len(idx) < need_n:
-                idx = np.argpartition(d, min(need_n, n) - 1)[: min(need_n, n)]
+            off, idx = bin_rows(wrapped, c, half, need_n)
             # The phase offset inside the window is a regressor too, so the drift of C
             # across the window is not mistaken for noise; it is dropped afterwards
             # (the bin's coefficients are those at the centre, offset 0). A single bin

@@ -41,7 +41,7 @@ from suds_exp.models.base import (
     require_columns,
 )
 from suds_exp.models.params import Options, Param
-from suds_exp.models.tls import TLS, tls_solve
+from suds_exp.models.tls import TLS, bin_rows, tls_solve
 from suds_exp.robot import VB_COLUMNS
 
 _TWO_PI = 2.0 * np.pi
@@ -146,11 +146,7 @@ class TLSFinsler(TLS):
         seen = np.zeros((self.n_bins, p), dtype=bool)
         n_kept = n_dirs = 0
         for b, c in enumerate(centres):
-            off = np.angle(np.exp(1j * (wrapped - c)))
-            d = np.abs(off)
-            idx = np.flatnonzero(d <= half)
-            if len(idx) < need_n:
-                idx = np.argpartition(d, min(need_n, n) - 1)[: min(need_n, n)]
+            off, idx = bin_rows(wrapped, c, half, need_n)
             Xb, sxb = X[idx], sx
             if self.n_bins > 1:
                 # A's drift across the window: offset x rate, of degree one in u too
