@@ -23,6 +23,14 @@ def interval_text(value: float, low: float, high: float, digits: int = 2) -> str
     return text
 
 
+def not_measured(columns, reason: str) -> pd.DataFrame:
+    """An empty table of ``columns`` that says why it is empty (``attrs["reason"]``), as
+    the diagnostics return one when the data cannot give them."""
+    table = pd.DataFrame(columns=list(columns))
+    table.attrs["reason"] = reason
+    return table
+
+
 def _cell(value, digits: int) -> str:
     if value is None or value is pd.NA or (isinstance(value, float) and np.isnan(value)):
         return ""

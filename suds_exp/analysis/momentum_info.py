@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from suds_exp.analysis.formatting import interval_text
+from suds_exp.analysis.formatting import interval_text, not_measured
 
 #: Columns of the momentum-information table, one row per held-out frequency, then "all".
 MOMENTUM_COLUMNS = (
@@ -142,16 +142,12 @@ def campaign_momentum_information(store, campaign: str, **kwargs) -> pd.DataFram
     except SudsError:
         samples = None
     if samples is None or samples.empty:
-        return _empty("the campaign's samples are not stored")
+        return not_measured(MOMENTUM_COLUMNS, "the campaign's samples are not stored")
     table = momentum_information(samples, trials.set_index("trial_id")["frequency_hz"], **kwargs)
     if table.empty:
-        return _empty("the samples hold one gait frequency; a lag shows only across speeds")
-    return table
-
-
-def _empty(reason: str) -> pd.DataFrame:
-    table = pd.DataFrame(columns=MOMENTUM_COLUMNS)
-    table.attrs["reason"] = reason
+        return not_measured(
+            MOMENTUM_COLUMNS, "the samples hold one gait frequency; a lag shows only across speeds"
+        )
     return table
 
 

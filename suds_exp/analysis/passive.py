@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from suds_exp.analysis.formatting import interval_text
+from suds_exp.analysis.formatting import interval_text, not_measured
 from suds_exp.errors import AnalysisError
 
 #: What `passive_information` means, printed beside it by the demo and the report.
@@ -165,21 +165,16 @@ def campaign_passive_information(store, campaign: str, **kwargs) -> pd.DataFrame
         samples = None
     if samples is None or samples.empty:
         # results without stored samples (imported, synthetic): nothing to measure
-        return _no_passive("the campaign's samples are not stored")
+        return not_measured(PASSIVE_COLUMNS, "the campaign's samples are not stored")
     if not any(c.startswith("rp_") for c in samples):
-        return _no_passive("the samples have no passive shape (rp_*)")
+        return not_measured(PASSIVE_COLUMNS, "the samples have no passive shape (rp_*)")
     table = passive_information(samples, **kwargs)
     if table.empty:
-        return _no_passive(
+        return not_measured(
+            PASSIVE_COLUMNS,
             f"no condition has two trials at one frequency in the {len(samples):,} stored "
-            "samples (a pair fits on one trial and tests on another)"
+            "samples (a pair fits on one trial and tests on another)",
         )
-    return table
-
-
-def _no_passive(reason: str) -> pd.DataFrame:
-    table = pd.DataFrame(columns=PASSIVE_COLUMNS)
-    table.attrs["reason"] = reason
     return table
 
 
