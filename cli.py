@@ -174,6 +174,7 @@ def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None =
         @functools.wraps(fn)
         def run(*a, **kw):
             try:
+                _one_output(kw)
                 return fn(*a, **kw)
             except SudsError as exc:
                 console.err.print(
@@ -201,6 +202,15 @@ def command(*args, flags: dict[str, str] | None = None, on: typer.Typer | None =
         return (on or app).command(*args, cls=Command, **kwargs)(run)
 
     return wrap
+
+
+def _one_output(options: dict) -> None:
+    """Refuse output flags that contradict: each of --json and --csv prints the whole
+    output, and --table picks the table --csv prints (without it, it would be dropped)."""
+    if options.get("json_") and options.get("csv"):
+        raise ConfigError("--json and --csv each print the whole output: give one of them")
+    if options.get("table") is not None and not options.get("csv"):
+        raise ConfigError("--table goes with --csv: it picks the table printed as CSV")
 
 
 def _print_version(value: bool) -> None:
@@ -670,11 +680,12 @@ def survey(
     json_: JsonOption = False,
     csv: CsvOption = False,
     table: Annotated[
-        str,
+        str | None,
         typer.Option(
-            help="With --csv: cycles (cycles to target, the default with a sweep) | timing | glm."
+            help="With --csv: cycles (cycles to target, the default) | timing | glm.",
+            show_default=False,
         ),
-    ] = "cycles",
+    ] = None,
 ) -> None:
     """Data each learner needs and its speed: cycles to reach x1.25 of its own largest-sweep
     error and GMR's 30-cycle error, per frequency, and the VERSUS/GMR data ratio (from a
@@ -691,8 +702,8 @@ def survey(
     from suds_exp.commands.survey import print_survey, survey_frame
 
     tables = survey_tables(open_store(db), name, cycles, either(boots, n_boot), versus)
-    if csv and not json_:
-        console.print_csv(survey_frame(tables, table))
+    if csv:
+        console.print_csv(survey_frame(tables, table or "cycles"))
     elif json_:
         console.print_json(survey_json(tables))
     else:
@@ -786,12 +797,13 @@ def findings(
     json_: JsonOption = False,
     csv: CsvOption = False,
     table: Annotated[
-        str,
+        str | None,
         typer.Option(
-            help="With --csv: findings | passive (what the passive shape adds) | momentum "
-            "(what the velocity history adds)."
+            help="With --csv: findings (the default) | passive (what the passive shape adds) "
+            "| momentum (what the velocity history adds).",
+            show_default=False,
         ),
-    ] = "findings",
+    ] = None,
 ) -> None:
     """The paper's findings F1-F10 measured on a campaign: statistic, value, 95 % bootstrap
     interval, holds / unclear / fails / not measurable (definitions: the documentation's
@@ -804,8 +816,9 @@ def findings(
     from suds_exp.commands.findings import findings_frame, show_findings
 
     n_boot = either(boots, boot)
-    if csv and not json_:
-        console.print_csv(findings_frame(open_store(db), name, table, n_boot=n_boot, seed=seed))
+    if csv:
+        frame = findings_frame(open_store(db), name, table or "findings", n_boot=n_boot, seed=seed)
+        console.print_csv(frame)
         return
     show_findings(open_store(db), name, n_boot=n_boot, seed=seed, as_json=json_)
 

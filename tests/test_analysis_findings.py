@@ -176,3 +176,19 @@ def test_cli_findings_csv_gives_each_table_unrounded(store):
     out = runner.invoke(app, [*args, "--csv", "--table", "nope"])
     assert out.exit_code == 2 and "--table 'nope'" in out.output
     assert "findings, passive, momentum" in out.output
+
+
+def test_cli_output_flags_that_contradict_are_refused(store):
+    # --table picks the table --csv prints; alone, or beside --json, it would be dropped
+    runner = CliRunner()
+    args = ["findings", "exact", "--db", str(store.path), "--boots", "10"]
+    for extra, named in [
+        (["--table", "passive"], "--table"),
+        (["--csv", "--json"], "--json"),
+        (["--json", "--table", "passive"], "--table"),
+    ]:
+        out = runner.invoke(app, [*args, *extra])
+        assert out.exit_code == 2, (extra, out.output)
+        assert named in out.output and len(out.output.splitlines()) == 1
+    out = runner.invoke(app, ["sql", "SELECT 1 AS x", "--db", str(store.path), "--json", "--csv"])
+    assert out.exit_code == 2 and "--csv" in out.output
