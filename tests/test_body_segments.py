@@ -24,7 +24,7 @@ from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 
-#: The done-when tolerances of issue 30.
+#: Tolerances a body description must meet against the simulator's joint angles.
 ANGLE_RMS_RAD = 0.01
 VELOCITY_RMS_FRACTION = 0.05
 

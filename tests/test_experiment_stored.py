@@ -1,5 +1,5 @@
-"""The experiment stays with the data (issue 39, part 4) and reports degrade instead of
-vanishing (part 5): the description given at ingest is stored, and run, report, findings
+"""The experiment stays with the data and reports degrade instead of
+vanishing: the description given at ingest is stored, and run, report, findings
 and status read it without ``--experiment``; trials a loop adds become levels of the
 stored design; a report section that cannot be computed says why on the page."""
 
@@ -156,7 +156,7 @@ def test_another_description_is_refused_and_leaves_the_database_as_it_was(own_db
 
 
 def test_report_without_experiment_reads_the_stored_design(own, tmp_path):
-    # issue 39: this printed a traceback (KeyError ... 'gait_sim')
+    # a design not given again once printed a traceback (KeyError ... 'gait_sim')
     db, _ = own
     out = tmp_path / "report"
     ok("report", "own", "--out", out, "--db", db)
@@ -347,7 +347,7 @@ def tiny(tmp_path_factory) -> Path:
 
 
 def test_the_tiny_campaigns_report_is_written_and_says_why_the_glm_is_missing(tiny, tmp_path):
-    # issue 39: "GLM: only 4 learner results at 2 cycles; need 10+" and an empty folder
+    # once: "GLM: only 4 learner results at 2 cycles; need 10+" and an empty folder
     out = tmp_path / "tiny"
     ok("report", "tiny", "--out", out, "--db", tiny)
     page = (out / "index.html").read_text()

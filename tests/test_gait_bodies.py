@@ -1,4 +1,4 @@
-"""Gait tools on bodies other than the swimmer (issue 39, part 6): described serial
+"""Gait tools on bodies other than the swimmer: described serial
 bodies of 2, 3 and 5 links (1, 2 and 4 actuated joints) moved by the kinematic generator,
 ingested and preprocessed through the CLI; gait files named by the body's joints;
 predict, connection and design work or refuse in one line; the support flag; estimates
@@ -128,7 +128,7 @@ def test_gait_files_carry_one_column_per_joint_named_as_the_body(tmp_path):
 
 @pytest.mark.parametrize("body_db", [1], indirect=True)
 def test_the_silent_phi2_is_refused_naming_the_column_and_the_body_s_joints(body_db, tmp_path):
-    # issue 39: on a body with one actuated joint the gait's phi2 was ignored (the same
+    # once, on a body with one actuated joint the gait's phi2 was ignored (the same
     # prediction whether phi2 was an ellipse or zero)
     gait = wave_toml(tmp_path / "two.toml", ["phi1"], extra={"phi2": 1.0})
     line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boots", "0")
@@ -173,7 +173,7 @@ def test_predict_flags_a_gait_outside_the_data_s_support(body_db, tmp_path, requ
 
 @pytest.mark.parametrize("body_db", [2], indirect=True)
 def test_the_estimate_outside_its_interval_is_refused_or_explained(body_db, tmp_path):
-    # issue 39: `--boot 3` gave lateral_mm 12.97 against its interval [10.106, 12.703]:
+    # once, `--boot 3` gave lateral_mm 12.97 against its interval [10.106, 12.703]:
     # 3 refits cannot estimate 2.5 and 97.5 percentiles
     gait = wave_toml(tmp_path / "w.toml", ["q1", "q2"])
     line = refused(body_db, "gait", "predict", "--gait-file", gait, "--boots", "3")

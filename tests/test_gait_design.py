@@ -60,7 +60,7 @@ def db(small, tmp_path) -> Path:
 
 
 def test_the_simulator_reproduces_the_issue_figures():
-    # nominal robot, gait followed exactly at 1/2 Hz, mean of cycles 3-5 (issue 31)
+    # nominal robot, gait followed exactly at 1/2 Hz, mean of cycles 3-5
     gaits = paper_gaits() + [ellipse(1.2, 1.2), ellipse(1.2, 1.2, 0.5)]
     got = simulate_forward(gaits, 0.5)
     np.testing.assert_allclose(got, [23.9, 27.9, 24.3, 22.7, 30.6, 32.5, 54.4], atol=0.051)
@@ -93,7 +93,7 @@ def test_predict_interval_holds_its_estimate_or_says_why(db, tmp_path):
     assert doc["n_boot"] == 40
     for key in ("forward_mm", "lateral_mm", "turn_rad", "mean_vx_mm_s"):
         lo, hi = doc["interval"][key]
-        # every estimate lies inside its interval, or a note says why not (issue 39)
+        # every estimate lies inside its interval, or a note says why not
         assert lo <= doc[key] <= hi or "outside its interval" in doc["interval_notes"][key]
 
 
@@ -138,7 +138,7 @@ def test_design_with_verify_stores_every_iteration_and_adds_trials(db, tmp_path)
     n_versions = Store(db).query_df("SELECT count(*) AS n FROM prep_versions")["n"].iloc[0]
     assert n_versions == 1
     assert (Path(doc["report"])).is_file()
-    # and are levels of the stored design (issue 39): a plain run and report take them
+    # and are levels of the stored design: a plain run and report take them
     added = Store(db).query_df("SELECT level FROM experiment_levels WHERE added_by IS NOT NULL")
     assert sorted(added.level) == [f"design-{doc['design_id']}-it{i}.toml" for i in (1, 2)]
     ok("run", "after", "--models", "TLS", "--boots", "1", "--train-cycles", "3",
@@ -262,7 +262,7 @@ def test_connection_compares_the_learned_map_with_the_simulators(db, tmp_path):
 
 @pytest.mark.slow  # a verified design, a campaign, two reports and the findings: ~30 s
 def test_run_report_and_findings_work_after_verify(db, tmp_path):
-    # issue 39: the verify trials were conditions outside the design; the next plain run
+    # verify trials were once conditions outside the design; the next plain run
     # refused (a one-trial condition has no same-condition pair) and report crashed
     out = str(tmp_path / "out")
     ok("gait", "design", "--iterations", "1", "--verify", "--order", "1", "--out", out,

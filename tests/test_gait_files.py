@@ -103,7 +103,7 @@ def test_the_bound_is_a_parameter(tmp_path):
 
 def test_toml_errors_name_the_file(tmp_path):
     p = tmp_path / "g.toml"
-    # one table a joint: a file of [phi1] alone is a one-joint gait (issue 39); a loose
+    # one table a joint: a file of [phi1] alone is a one-joint gait; a loose
     # value where a joint's table belongs is refused
     p.write_text("phi1 = 1.0\n[phi2]\nsin = [1.0]\n")
     with pytest.raises(ConfigError, match=r"g.toml: entry 'phi1' is not a table; expected one"):

@@ -1,4 +1,4 @@
-"""Physics invariants of the granular RFT swimmer (issue 3, "Tests")."""
+"""Physics invariants of the granular RFT swimmer."""
 
 from __future__ import annotations
 

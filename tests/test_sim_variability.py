@@ -14,7 +14,7 @@ from suds_exp.sim.bed import bed_multiplier, draw_bed
 from suds_exp.sim.gaits import gait_shape
 
 DT = 0.01
-#: The variability of issue 17 switched on (off in the nominal robot).
+#: The robot's variability effects switched on (off in the nominal robot).
 VARIABILITY = (
     "servo.compliance_rad_per_n_m=0.05",
     "bed_heterogeneity.spatial_cv=0.2",

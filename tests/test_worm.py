@@ -47,7 +47,7 @@ def test_worm_agrees_with_the_tracker(tmp_path, features):
     out = run_worm(features, tmp_path / "w.duckdb")
     ref = tracker_reference(features)
     assert ref["bend_frequency_hz"] == pytest.approx(0.442, abs=0.001)
-    # the done-when tolerances of issue 30
+    # tolerances a tracked animal's phase rate must meet
     assert out["phase_rate_hz"][0] == pytest.approx(ref["bend_frequency_hz"], rel=0.15)
     assert out["forward_speed_mm_s"] == pytest.approx(ref["speed_mm_s"], rel=0.30)
     assert sum(out["explained_variance_ratio"][:2]) > 0.9  # a travelling wave: 2 modes

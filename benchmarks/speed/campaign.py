@@ -13,7 +13,7 @@ cycle has 100 samples as in the paper's data. Figures:
 - overhead: wall time of `run_campaign` (in-process, fresh database: definition, sample
   bank, sampling, frames, database writes) over the time of the same jobs' make_model +
   fit + predict in a bare loop on frames built beforehand; 4 conditions, 16 pairs x 3 draws,
-  all five learners, 30 training cycles as in the paper. Target (issue 32): <= 3 % at
+  all five learners, 30 training cycles as in the paper. Target: <= 3 % at
   paper scale, where the fixed cost of a run is paid once for 21,000 jobs.
 - overhead is given two ways: over the learners' own fit + predict time recorded in the
   same run (immune to load changes between runs), and over a separate bare loop.

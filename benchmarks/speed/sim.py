@@ -1,4 +1,4 @@
-"""Simulator benchmark: speed on the default dataset, and the motion tables of issue 3.
+"""Simulator benchmark: speed on the default dataset, and the simulator page's motion tables.
 
 Run: .venv/bin/python -m benchmarks.speed.sim [--runs 3] [--out reports/sim-benchmark]
 

@@ -7,8 +7,8 @@ their defaults - the learners are never tuned here -, every pair of conditions w
 ``--boots`` draws at 30 training cycles, and the sweep ``--sweep`` on same-condition
 pairs) and measures the paper's findings F1-F10 with `suds_exp.analysis.findings`
 (the statistics of the README's "The paper's findings"; ``--n-boot`` replicates). It also
-prints, as the diagnosis of issue 17, how much of r_a, rp_1 and vx the gait phase leaves
-unexplained (RMS deviation from the phase-bin mean / SD, median over conditions).
+prints, as a diagnosis of the robot's variability, how much of r_a, rp_1 and vx the gait
+phase leaves unexplained (RMS deviation from the phase-bin mean / SD, median over conditions).
 
 Settings:
 
@@ -61,7 +61,7 @@ from suds_exp.sim import (
 )
 from suds_exp.store import Store
 
-#: Effects and their settings that describe a robot's variability (issue 17).
+#: Effects and their settings that describe a robot's variability.
 VARIABILITY_EFFECTS = (
     "servo",
     "bed_depth",
@@ -97,7 +97,7 @@ def effect_items(path: Path) -> list[str]:
     ]
 
 
-#: Settings by name: the robot before issue 17's variability, the nominal one and the
+#: Settings by name: the robot without variability effects, the nominal one and the
 #: calibrated one (`CALIBRATED`).
 NAMED = {
     "old": [f"{e}=off" for e in VARIABILITY_EFFECTS],

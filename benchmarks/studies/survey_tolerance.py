@@ -42,7 +42,7 @@ import pandas as pd
 
 from benchmarks._data import decimated, ensure_data
 
-#: The survey's recipe before session 15 ("old"), every setting a candidate changes
+#: The survey's earlier recipe ("old"), every setting a candidate changes
 #: pinned, so the reference does not move with the defaults; candidates change it.
 OLD_RECIPES = {
     "MLP": {"hidden_layer_sizes": [64, 64], "max_iter": 200, "tol": 1e-4},

@@ -329,7 +329,7 @@ def _glm_coef(label: str, term: str) -> Callable[[_Data], float]:
     return compute
 
 
-#: The findings, in the paper's order (ids as in issue 17's table).
+#: The findings, in the paper's order (ids as in the documentation's findings page).
 FINDINGS: tuple[Finding, ...] = (
     Finding(
         "F1",
