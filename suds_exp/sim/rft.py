@@ -19,8 +19,9 @@ Each step solves at the midpoint of the joint path (phi interpolated linearly be
 samples, d(phi)/dt the secant), flipper angles predicted half a step ahead; the pose is
 advanced with the SE(2) exponential of the twist.
 
-Per-trial parameters come in a vector `prm` of N_PARAMS (indices P_*), packed by
-`suds_exp.sim.mechanics.pack_params` in the scaled units above; body inertia relaxes the
+Per-trial parameters come in a vector `prm` (indices P_*, the slots that
+`suds_exp.sim.effect_params` declares), packed by `suds_exp.sim.mechanics.pack_params`
+in the scaled units above; body inertia relaxes the
 twist towards the quasi-static one with factor 1 - exp(-h / tau) per step.
 """
 
@@ -31,20 +32,22 @@ import math
 import numpy as np
 from numba import njit, prange
 
-P_CS, P_CF, P_CL, P_GAMMA, P_EPS, P_MU = 0, 1, 2, 3, 4, 5
-P_ASYM, P_NORMAL, P_COMPACT = 6, 7, 8
-P_K, P_PRELOAD, P_AMAX, P_CHINGE = 9, 10, 11, 12
-P_FLMODE, P_FLLOCK, P_TAU = 13, 14, 15
-P_TOL, P_MAXIT, P_SFLOOR, P_LREF, P_SUBSTEPS = 16, 17, 18, 19, 20
-# servo gain (scaled torque per rad, 0 = joints follow the given angles), stall torque
-# (scaled), back-EMF damping (scaled torque s/rad); hinge friction torques of flippers 1-4
-P_SGAIN, P_STALL, P_SDAMP = 21, 22, 23
-P_HFRIC = 24
-# grain-scale contact fluctuations: log-sd of each element's drag multiplier and the
-# share of its log-variance common to its whole part (the slip correlation length is in
-# the modes' wavenumbers)
-P_GSIG, P_GCOH = 28, 29
-N_PARAMS = 30
+from suds_exp.sim.effect_params import FlippersEffect, kernel_layout
+
+# the packed parameters' indices, from the slots the simulator's effects declare
+_SLOT = {k: i for k, (i, _) in kernel_layout().items()}
+P_CS, P_CF, P_CL = _SLOT["medium.cs"], _SLOT["medium.cf"], _SLOT["medium.cl"]
+P_GAMMA, P_EPS, P_MU = _SLOT["medium.gamma"], _SLOT["medium.eps"], _SLOT["medium.mu"]
+P_K, P_PRELOAD, P_AMAX = _SLOT["hinges.k"], _SLOT["hinges.preload"], _SLOT["hinges.amax"]
+P_TOL, P_MAXIT, P_SFLOOR = _SLOT["solver.tol"], _SLOT["solver.maxit"], _SLOT["solver.sfloor"]
+P_LREF, P_SUBSTEPS = _SLOT["solver.lref"], _SLOT["solver.substeps"]
+P_ASYM, P_NORMAL = _SLOT["asymmetric_drag.ratio"], _SLOT["drag_anisotropy.normal"]
+P_COMPACT, P_CHINGE = _SLOT["medium_compaction.rate"], _SLOT["hinge_damping.c"]
+P_FLMODE, P_FLLOCK = _SLOT["flippers.mode"], _SLOT["flippers.locked"]
+P_TAU = _SLOT["body_inertia.tau"]
+P_SGAIN, P_STALL, P_SDAMP = _SLOT["servo.gain"], _SLOT["servo.stall"], _SLOT["servo.damp"]
+P_HFRIC = _SLOT["hinge_friction.torque"]  # flippers 1-4 from here
+P_GSIG, P_GCOH = _SLOT["grain_contacts.sigma"], _SLOT["grain_contacts.coherence"]
 N_PARTS = 7
 # joint rate below which a servo loaded by the beans counts as stuck (rad/s)
 SERVO_STICK_RATE = 0.05
@@ -52,7 +55,7 @@ SERVO_STICK_RATE = 0.05
 SERVO_LOAD_TAU = 0.03
 HALF_MID = 0.5
 
-FL_FREE, FL_LOCKED, FL_ABSENT = 0, 1, 2
+FL_FREE, FL_LOCKED, FL_ABSENT = (FlippersEffect.MODES[m] for m in ("free", "locked", "absent"))
 N_UNKNOWN = 7
 # Newton step caps in scaled units (velocity / (L_ref * shape rate), hinge rate / shape rate)
 STEP_BODY = 0.1
@@ -990,7 +993,7 @@ def run_trials(
 
     phi: (n_trials, n_frames, 2) rad, sampled every dt s; n_steps[k] frames used by
     trial k: the joint angles, or the servo command when prm[k, P_SGAIN] > 0. pose0
-    (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, N_PARAMS); bed
+    (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, n_params); bed
     (n_trials, n_modes, 4) random Fourier modes of the bed (kx, ky in 1/mm, phase,
     amplitude; see bed.py) and bed_scale (n_trials,) its trial factor; grains (n_trials,
     n_el + N_PARTS, n_modes, 2) the grain contacts' random modes in slip distance (see
