@@ -21,6 +21,7 @@ import pandas as pd
 from suds_exp.campaign import KEY_COLUMNS, TIMING_COLUMNS
 from suds_exp.robot import GAIT_K
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_captures import qtm_text, random_track  # noqa: F401 (the tests' name)
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -97,39 +98,6 @@ def sql(db, query):
 
 
 # -- capture files ----------------------------------------------------------------------
-def qtm_text(names: list[str], xyz: np.ndarray, rate: float = 100.0, crlf: bool = True) -> str:
-    """A QTM 3D TSV export of ``xyz`` (n_frames, n_markers, 3) mm; NaN -> 0 0 0."""
-    n_frames = xyz.shape[0]
-    head = [
-        f"NO_OF_FRAMES\t{n_frames}",
-        "NO_OF_CAMERAS\t4",
-        f"NO_OF_MARKERS\t{len(names)}",
-        f"FREQUENCY\t{rate:g}",
-        "NO_OF_ANALOG\t0",
-        "ANALOG_FREQUENCY\t0",
-        "DESCRIPTION\t--",
-        "TIME_STAMP\t2026-01-01, 10:00:00.000\t0.0",
-        "DATA_INCLUDED\t3D",
-        "MARKER_NAMES\t" + "\t".join(names),
-        "TRAJECTORY_TYPES\t" + "\t".join(["Mixed"] * len(names)),
-        "Frame\tTime\t" + "\t".join(f"{n} {a}" for n in names for a in "XYZ") + "\t",
-    ]
-    values = np.nan_to_num(xyz, nan=0.0).reshape(n_frames, -1)
-    rows = [
-        f"{i + 1}\t{i / rate:.5f}\t" + "\t".join(f"{v:.3f}" for v in row) + "\t"
-        for i, row in enumerate(values)
-    ]
-    return ("\r\n" if crlf else "\n").join(head + rows) + ("\r\n" if crlf else "\n")
-
-
-def random_track(n_frames: int, n_markers: int, seed: int = 0) -> np.ndarray:
-    """Smooth random marker tracks, shape (n_frames, n_markers, 3), mm."""
-    rng = np.random.default_rng(seed)
-    base = rng.uniform(-300, 300, size=(1, n_markers, 3))
-    drift = np.cumsum(rng.normal(0, 0.5, size=(n_frames, n_markers, 3)), axis=0)
-    return np.round(base + drift, 3)
-
-
 def write_c3d(path, names, xyz, rate=100.0, units="mm  ", scale=1.0):
     """A C3D file of ``xyz`` (n_frames, n_markers, 3), NaN as an invalid point."""
     import c3d

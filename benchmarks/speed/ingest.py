@@ -7,7 +7,7 @@ Prints the median wall time (over repeats) of `ingest_paths` on N files of F fra
     .venv/bin/python -m benchmarks.speed.ingest [--files 60] [--frames 4000] [--repeats 3]
 
 ``--quick``: 2 files of 200 frames, once (a smoke run, no figure). The QTM text comes
-from the test suite's helpers (`tests.helpers`), so run it from the repository root.
+from `suds_exp.testing.synthetic_captures` (random tracks with no truth to keep).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import pandas as pd
 
 from suds_exp.ingest import ROLES, ingest_paths
 from suds_exp.store import Store
-from tests.helpers import qtm_text, random_track
+from suds_exp.testing.synthetic_captures import qtm_text, random_track
 
 
 def main(argv=None) -> None:

@@ -9,8 +9,9 @@ from a JSON or TOML file whose sections and keys mirror the dataclass fields, e.
     damping = 5.0
 
 Units are in the field names or comments: lengths mm, angles rad unless `_deg`, time s.
-The named effects (section `effects`) carry per-parameter metadata (unit, nominal value,
-realistic range) that `suds_exp.sim.effects.effect_library()` publishes as data.
+The named effects (section `effects`, declared in `suds_exp.sim.effect_params`) carry
+per-parameter metadata (unit, nominal value, realistic range) that
+`suds_exp.sim.effects.effect_library()` publishes as data.
 """
 
 from __future__ import annotations
@@ -24,14 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from suds_exp.errors import ConfigError
-
-
-def _p(
-    unit: str, low: Any, high: Any, doc: str, main: bool = False, on: Any = None, off: Any = None
-) -> dict:
-    """Field metadata of an effect parameter: unit, realistic range, meaning; for the
-    main parameter also its typical "on" value and its "off" value (no effect)."""
-    return {"unit": unit, "range": (low, high), "doc": doc, "main": main, "on": on, "off": off}
+from suds_exp.sim import effect_params
+from suds_exp.sim.effect_params import effect_param
 
 
 @dataclass
@@ -102,10 +97,10 @@ class Hinges:
 
     spring_n_mm_per_rad: float = field(
         default=20.0,
-        metadata=_p("N mm/rad", 5.0, 300.0, "torsional stiffness of a tape live hinge"),
+        metadata=effect_param("N mm/rad", 5.0, 300.0, "torsional stiffness of a tape live hinge"),
     )
     preload_rad: float = field(
-        default=0.1, metadata=_p("rad", 0.0, 0.5, "spring pre-bend of a closed flipper")
+        default=0.1, metadata=effect_param("rad", 0.0, 0.5, "spring pre-bend of a closed flipper")
     )
     open_stop_deg: float = 80.0
 
@@ -155,338 +150,6 @@ class Solver:
 
 
 @dataclass
-class FlippersEffect:
-    """Passive flippers: free on their spring hinges, locked at a fixed opening, or
-    removed. Locking removes the passive shape and the flippers' ratchet-like thrust."""
-
-    mode: str = field(
-        default="free",
-        metadata=_p(
-            "-", "free", "absent", "free | locked | absent", main=True, on="locked", off="free"
-        ),
-    )
-    locked_angle_deg: float = field(
-        default=0.0, metadata=_p("deg", 0.0, 80.0, "opening of locked flippers")
-    )
-
-
-@dataclass
-class HingeDampingEffect:
-    """Viscous friction in the tape hinges: flippers lag behind, more at high frequency."""
-
-    damping: float = field(
-        default=0.0,
-        metadata=_p(
-            "N mm s/rad", 0.0, 200.0, "viscous torque per hinge rate", main=True, on=50.0, off=0.0
-        ),
-    )
-
-
-@dataclass
-class BodyInertiaEffect:
-    """Momentum: the body twist relaxes towards the quasi-static one with time constant
-    tau, so motion lags the shape and shrinks at high frequency (speed dependence)."""
-
-    tau_s: float = field(
-        default=0.0,
-        metadata=_p(
-            "s",
-            0.0,
-            0.5,
-            "body velocity relaxes to the quasi-static one",
-            main=True,
-            on=0.15,
-            off=0.0,
-        ),
-    )
-
-
-@dataclass
-class AsymmetricDragEffect:
-    """Tangential drag on the segments differs sliding forward (towards the head) vs
-    backward (grain texture, surface finish): slows or speeds the forward glide."""
-
-    ratio: float = field(
-        default=1.0,
-        metadata=_p(
-            "-",
-            0.5,
-            2.5,
-            "tangential drag on the segments sliding forward / backward",
-            main=True,
-            on=1.8,
-            off=1.0,
-        ),
-    )
-
-
-@dataclass
-class DragAnisotropyEffect:
-    """Normal vs tangential drag ratio differs from glass beads (beans are not beads):
-    scales all propulsion and the lateral slip."""
-
-    normal_scale: float = field(
-        default=1.0,
-        metadata=_p("-", 0.5, 2.0, "multiplies the normal drag C_S", main=True, on=1.5, off=1.0),
-    )
-
-
-@dataclass
-class MediumCompactionEffect:
-    """The bed compacts as the robot ploughs through it: normal drag grows with distance
-    travelled, so speed drifts along a trial."""
-
-    rate_per_m: float = field(
-        default=0.0,
-        metadata=_p(
-            "1/m",
-            0.0,
-            3.0,
-            "normal drag grows by this fraction per metre travelled",
-            main=True,
-            on=1.5,
-            off=0.0,
-        ),
-    )
-
-
-@dataclass
-class SpokeOscillationEffect:
-    """Raised spoke markers ring on their skewers (damped oscillation driven by the
-    spoke base's acceleration); affects the measured markers, not the body."""
-
-    gain: float = field(
-        default=1.0,
-        metadata=_p(
-            "-",
-            0.0,
-            3.0,
-            "spoke marker response to base acceleration (1 = rigid mass on spring)",
-            main=True,
-            on=1.0,
-            off=0.0,
-        ),
-    )
-    freq_hz: float = field(
-        default=5.0, metadata=_p("Hz", 2.0, 10.0, "natural frequency of the spoke")
-    )
-    damping_ratio: float = field(
-        default=0.15, metadata=_p("-", 0.02, 0.4, "damping ratio of the spoke")
-    )
-
-
-@dataclass
-class ServoEffect:
-    """Compliant position servos (hobby / Dynamixel class): the joint is driven by a
-    proportional controller saturating at the stall torque, minus back-EMF damping
-    (torque = clip(error / compliance, +-stall) - stall / no_load_speed * rate), against
-    the medium's torque on the segment and its flippers. Under load r_a lags and falls
-    short of the command, more in stiffer ground and at higher speed, so r_a carries
-    the force the beans exert. Only the commanded drive feels it: replaying measured
-    joint angles already contains it."""
-
-    compliance_rad_per_n_m: float = field(
-        default=0.0,
-        metadata=_p(
-            "rad/(N m)",
-            0.0,
-            0.5,
-            "joint deflection per unit load torque below stall (1 / proportional gain); "
-            "Dynamixel AX-12A: compliance slope 2-128 steps of 0.29 deg to its 1.5 N m "
-            "stall = 0.007-0.43, default 32 steps = 0.11 (ROBOTIS e-manual)",
-            main=True,
-            on=0.1,
-            off=0.0,
-        ),
-    )
-    stall_torque_n_m: float = field(
-        default=4.0,
-        metadata=_p(
-            "N m",
-            0.5,
-            6.0,
-            "torque at zero speed (ROBOTIS e-manual: AX-12A 1.5, MX-28 2.5, "
-            "MX-64 6.0 N m; hobby MG996R ~1 N m)",
-        ),
-    )
-    no_load_speed_rad_s: float = field(
-        default=6.2,
-        metadata=_p(
-            "rad/s",
-            4.0,
-            12.0,
-            "joint speed at zero torque (AX-12A 59 rpm = 6.2 rad/s, "
-            "MG996R 0.17 s/60 deg = 6.2 rad/s)",
-        ),
-    )
-
-
-@dataclass
-class BedHeterogeneityEffect:
-    """The bed of beans is remixed and levelled by hand between trials, so resistance
-    (packing fraction, immersion depth) varies across the tub: a log-normal random field
-    of mean 1 with Gaussian correlation over `correlation_mm`, multiplying every
-    element's drag where it is. Drawn anew for every trial from the trial's seed (a
-    replay of measured joint angles, which cannot know the field, sees the mean bed)."""
-
-    spatial_cv: float = field(
-        default=0.0,
-        metadata=_p(
-            "-",
-            0.0,
-            0.5,
-            "coefficient of variation of the resistance over the tub",
-            main=True,
-            on=0.2,
-            off=0.0,
-        ),
-    )
-    correlation_mm: float = field(
-        default=300.0,
-        metadata=_p("mm", 100.0, 1000.0, "correlation length of the field (robot: 320 mm)"),
-    )
-
-
-@dataclass
-class BedPackingEffect:
-    """Each remix leaves the whole bed a little looser or denser and the robot a little
-    deeper or shallower: one log-normal resistance factor of mean 1 per trial (drawn from
-    the trial's seed) on every element. Kinematics of a rigid robot are blind to a uniform
-    factor (rate- and scale-independent RFT); compliant servos and flipper hinges are not."""
-
-    trial_cv: float = field(
-        default=0.0,
-        metadata=_p(
-            "-",
-            0.0,
-            0.4,
-            "coefficient of variation of the bed's resistance from trial to trial",
-            main=True,
-            on=0.2,
-            off=0.0,
-        ),
-    )
-
-
-@dataclass
-class HingeFrictionEffect:
-    """Dry (Coulomb) friction in the flippers' tape hinges, different for every flipper:
-    flipper i gets torque x (1 + spread x (+1, -1/3, +1/3, -1)[i]); a flipper resting on a
-    stop leaves it only once the net torque beats its friction (stiction)."""
-
-    torque_n_mm: float = field(
-        default=0.0,
-        metadata=_p(
-            "N mm", 0.0, 60.0, "mean friction torque of a hinge", main=True, on=15.0, off=0.0
-        ),
-    )
-    spread: float = field(
-        default=0.5, metadata=_p("-", 0.0, 1.0, "relative flipper-to-flipper variation")
-    )
-
-
-@dataclass
-class BedDepthEffect:
-    """The robot rests on the bed at a depth set by the beans' bearing under its whole
-    footprint, and a hand-levelled bed is denser in some places than others, so the
-    immersion depth changes as the robot travels. RFT stress grows with depth, so every
-    element's drag changes by one common factor (log-normal, mean 1) taken from a random
-    field over the tub at the body's position. A uniform factor leaves a rigid robot's
-    kinematics unchanged (RFT is scale free); it loads the servos and the flipper hinges.
-    Drawn anew for every trial from its seed."""
-
-    cv: float = field(
-        default=0.0,
-        metadata=_p(
-            "-",
-            0.0,
-            0.5,
-            "coefficient of variation of the drag from the immersion depth along the tub "
-            "(drag grows about as depth^2 for plates reaching from the surface, Maladen et "
-            "al. 2009; +-2-4 mm of a 20 mm immersion gives 0.2-0.4)",
-            main=True,
-            on=0.25,
-            off=0.0,
-        ),
-    )
-    correlation_mm: float = field(
-        default=200.0,
-        metadata=_p("mm", 50.0, 1000.0, "correlation length of the depth field over the tub"),
-    )
-
-
-@dataclass
-class GrainContactsEffect:
-    """Grain-scale fluctuations of the granular drag: the force chains in front of each
-    part of the robot jam and collapse as it slips through the beans (stick-slip), so
-    the drag on every RFT element is its mean times a log-normal factor of mean 1 that
-    changes over a slip distance of the order of a grain diameter (an Ornstein-Uhlenbeck
-    process in the element's own slip distance: rate independent), partly shared by the
-    elements of one segment or flipper. Drawn from the trial's seed."""
-
-    cv: float = field(
-        default=0.0,
-        metadata=_p(
-            "-",
-            0.0,
-            1.0,
-            "coefficient of variation of an element's drag (Albert et al. 2001 PRE "
-            "64 031307: stick-slip drag fluctuations of the order of the mean force; "
-            "Hossain & Rognon 2020: drops of up to 60 %)",
-            main=True,
-            on=0.4,
-            off=0.0,
-        ),
-    )
-    correlation_mm: float = field(
-        default=15.0,
-        metadata=_p(
-            "mm",
-            5.0,
-            40.0,
-            "slip distance over which the contacts renew: 0.5-4 grain diameters "
-            "(red beans 8-15 mm)",
-        ),
-    )
-    coherence: float = field(
-        default=0.5,
-        metadata=_p("-", 0.0, 1.0, "share of the log-variance common to a whole part"),
-    )
-
-
-@dataclass
-class Effects:
-    """The named candidate effects; defaults are the nominal configuration."""
-
-    flippers: FlippersEffect = field(default_factory=FlippersEffect)
-    hinge_damping: HingeDampingEffect = field(default_factory=HingeDampingEffect)
-    body_inertia: BodyInertiaEffect = field(default_factory=BodyInertiaEffect)
-    asymmetric_drag: AsymmetricDragEffect = field(default_factory=AsymmetricDragEffect)
-    drag_anisotropy: DragAnisotropyEffect = field(default_factory=DragAnisotropyEffect)
-    medium_compaction: MediumCompactionEffect = field(default_factory=MediumCompactionEffect)
-    spoke_oscillation: SpokeOscillationEffect = field(default_factory=SpokeOscillationEffect)
-    servo: ServoEffect = field(default_factory=ServoEffect)
-    bed_heterogeneity: BedHeterogeneityEffect = field(default_factory=BedHeterogeneityEffect)
-    bed_packing: BedPackingEffect = field(default_factory=BedPackingEffect)
-    hinge_friction: HingeFrictionEffect = field(default_factory=HingeFrictionEffect)
-    grain_contacts: GrainContactsEffect = field(default_factory=GrainContactsEffect)
-    bed_depth: BedDepthEffect = field(default_factory=BedDepthEffect)
-
-
-#: Effects drawn anew for every trial from its seed: a replay of measured joint angles
-#: cannot reproduce them sample by sample and simulates their mean (a uniform bed).
-PER_TRIAL_RANDOM_EFFECTS = (
-    "bed_heterogeneity",
-    "bed_packing",
-    "grain_contacts",
-    "bed_depth",
-)
-#: Effects acting between the command and the joint angles: invisible when measured
-#: joint angles are replayed.
-COMMAND_ONLY_EFFECTS = ("servo",)
-
-
-@dataclass
 class SimConfig:
     """Everything the simulator needs; `SimConfig()` is the nominal robot."""
 
@@ -496,7 +159,7 @@ class SimConfig:
     actuator: Actuator = field(default_factory=Actuator)
     measurement: Measurement = field(default_factory=Measurement)
     solver: Solver = field(default_factory=Solver)
-    effects: Effects = field(default_factory=Effects)
+    effects: effect_params.Effects = field(default_factory=lambda: effect_params.Effects())
 
     def copy(self) -> SimConfig:
         return copy.deepcopy(self)
@@ -611,23 +274,10 @@ def validate_config(cfg: SimConfig) -> None:
     ):
         if not value > 0:
             raise ConfigError(f"config.effects.{name}: must be > 0, got {value}")
-    _check_ranges(
-        cfg,
-        (
-            "servo",
-            "bed_heterogeneity",
-            "bed_packing",
-            "hinge_friction",
-            "grain_contacts",
-            "bed_depth",
-        ),
-    )
-
-
-def _check_ranges(cfg: SimConfig, effects: tuple[str, ...]) -> None:
-    """Raise `ConfigError` for a parameter of ``effects`` outside its declared range."""
-    for name in effects:
-        _check_fields(getattr(cfg.effects, name), f"config.effects.{name}")
+    # the first effects check their own domains above; the rest, their declared ranges
+    for name, cls in effect_params.EFFECTS.items():
+        if getattr(cls, "range_checked", True):
+            _check_fields(getattr(cfg.effects, name), f"config.effects.{name}")
 
 
 def _check_fields(obj: Any, where: str) -> None:

@@ -12,22 +12,20 @@ import inspect
 from collections.abc import Mapping
 
 from suds_exp.errors import ConfigError
-from suds_exp.sim.config import (
-    COMMAND_ONLY_EFFECTS,
-    PER_TRIAL_RANDOM_EFFECTS,
-    Effects,
-    SimConfig,
-    config_from_dict,
-)
+from suds_exp.sim import effect_params
+from suds_exp.sim.config import SimConfig, config_from_dict
 
-EFFECT_NAMES = tuple(f.name for f in dataclasses.fields(Effects))
+#: The built-in effects' names (`effect_params.EFFECTS` also holds any registered later).
+EFFECT_NAMES = tuple(effect_params.EFFECTS)
 
 
 def _effect_class(name: str):
-    for f in dataclasses.fields(Effects):
-        if f.name == name:
-            return f.default_factory
-    raise ConfigError(f"effect {name!r}: expected one of {', '.join(EFFECT_NAMES)}")
+    try:
+        return effect_params.EFFECTS[name]
+    except KeyError:
+        raise ConfigError(
+            f"effect {name!r}: expected one of {', '.join(effect_params.EFFECTS)}"
+        ) from None
 
 
 def _main_field(name: str) -> dataclasses.Field:
@@ -45,11 +43,10 @@ def effect_library(config: SimConfig | None = None) -> list[dict]:
     {``name``, ``unit``, ``nominal``, ``value`` (in `config`), ``range`` [low, high],
     ``description``, ``config_key`` (dotted path in the config file)}.
     """
-    nominal = Effects()
+    nominal = SimConfig().effects
     current = (config or SimConfig()).effects
     out = []
-    for name in EFFECT_NAMES:
-        cls = _effect_class(name)
+    for name, cls in effect_params.EFFECTS.items():
         main = _main_field(name)
         params = []
         for f in dataclasses.fields(cls):
@@ -67,7 +64,7 @@ def effect_library(config: SimConfig | None = None) -> list[dict]:
             )
         off = main.metadata["off"]
 
-        def state(effects: Effects, name=name, main=main, off=off) -> str:
+        def state(effects, name=name, main=main, off=off) -> str:
             value = getattr(getattr(effects, name), main.name)
             if isinstance(value, str):
                 return value
@@ -82,11 +79,7 @@ def effect_library(config: SimConfig | None = None) -> list[dict]:
                 "off_value": off,
                 "nominal_state": state(nominal),
                 "state": state(current),
-                "replay": "mean"
-                if name in PER_TRIAL_RANDOM_EFFECTS
-                else "none"
-                if name in COMMAND_ONLY_EFFECTS
-                else "exact",
+                "replay": getattr(cls, "replay", "exact"),
                 "parameters": params,
             }
         )

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
-from numba import njit
+
+from suds_exp.sim._jit import njit
 
 TRUTH_COLUMNS = (
     "t",

@@ -7,7 +7,6 @@ discrepancy workflow (replay measured phi1, phi2) call.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,10 +15,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.sim import rft
 from suds_exp.sim.bed import draw_bed, draw_grains
 from suds_exp.sim.config import SimConfig
-
-#: Relative deviation of flipper_1..flipper_4's hinge friction from the mean, x spread.
-HINGE_FRICTION_PATTERN = (1.0, -1 / 3, 1 / 3, -1.0)
-FLIPPER_MODES = {"free": rft.FL_FREE, "locked": rft.FL_LOCKED, "absent": rft.FL_ABSENT}
+from suds_exp.sim.effect_params import kernel_layout, kernel_values
 
 
 @dataclass(frozen=True)
@@ -104,51 +100,13 @@ def element_table(cfg: SimConfig) -> ElementTable:
 
 
 def pack_params(cfg: SimConfig) -> np.ndarray:
-    """Kernel parameter vector (rft.N_PARAMS,) of one configuration (scaled units)."""
-    g, m, hg, ef, sv = cfg.geometry, cfg.medium, cfg.hinges, cfg.effects, cfg.solver
-    L = g.middle_length_mm
-    force_unit = m.stress_scale_n_per_mm2 * g.segment_depth_mm * L  # N
-    torque_unit = force_unit * L  # N mm
-    p = np.zeros(rft.N_PARAMS)
-    p[rft.P_CS] = m.c_s
-    p[rft.P_CF] = m.c_f
-    p[rft.P_CL] = m.c_l
-    p[rft.P_GAMMA] = m.gamma
-    p[rft.P_EPS] = m.smoothing_rel
-    p[rft.P_MU] = m.regularization
-    p[rft.P_ASYM] = ef.asymmetric_drag.ratio
-    p[rft.P_NORMAL] = ef.drag_anisotropy.normal_scale
-    p[rft.P_COMPACT] = ef.medium_compaction.rate_per_m * L / 1000.0
-    p[rft.P_K] = hg.spring_n_mm_per_rad / torque_unit
-    p[rft.P_PRELOAD] = hg.preload_rad
-    p[rft.P_AMAX] = math.radians(hg.open_stop_deg)
-    p[rft.P_CHINGE] = ef.hinge_damping.damping / torque_unit
-    try:
-        p[rft.P_FLMODE] = FLIPPER_MODES[ef.flippers.mode]
-    except KeyError:
-        raise ConfigError(
-            f"effects.flippers.mode: {ef.flippers.mode!r}; expected {', '.join(FLIPPER_MODES)}"
-        ) from None
-    p[rft.P_FLLOCK] = math.radians(ef.flippers.locked_angle_deg)
-    p[rft.P_TAU] = ef.body_inertia.tau_s
-    p[rft.P_TOL] = sv.tol
-    p[rft.P_MAXIT] = sv.max_iter
-    p[rft.P_SFLOOR] = sv.shape_rate_floor
-    p[rft.P_LREF] = L
-    p[rft.P_SUBSTEPS] = sv.substeps
-    servo = ef.servo
-    if servo.compliance_rad_per_n_m > 0:
-        stall = servo.stall_torque_n_m * 1000.0 / torque_unit
-        p[rft.P_SGAIN] = 1000.0 / servo.compliance_rad_per_n_m / torque_unit
-        p[rft.P_STALL] = stall
-        p[rft.P_SDAMP] = stall / servo.no_load_speed_rad_s
-    gr = ef.grain_contacts
-    if gr.cv > 0:
-        p[rft.P_GSIG] = math.sqrt(math.log1p(gr.cv**2))
-        p[rft.P_GCOH] = gr.coherence
-    fr = ef.hinge_friction
-    for i, pattern in enumerate(HINGE_FRICTION_PATTERN):
-        p[rft.P_HFRIC + i] = fr.torque_n_mm * (1.0 + fr.spread * pattern) / torque_unit
+    """Kernel parameter vector (n_params,) of one configuration (scaled units), laid out
+    by `effect_params.kernel_layout` (the solver's ``P_*`` indices)."""
+    layout = kernel_layout()
+    p = np.zeros(sum(n for _, n in layout.values()))
+    for key, value in kernel_values(cfg).items():
+        start, n = layout[key]
+        p[start : start + n] = value
     return p
 
 

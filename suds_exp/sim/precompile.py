@@ -3,9 +3,10 @@
 The kernels (`suds_exp.sim.rft`, `suds_exp.sim.files`) are compiled with ``cache=True``:
 the first process that calls one compiles it (some 15 CPU seconds for the RFT solver)
 and every later process loads it from ``__pycache__`` in a fraction of a second. The
-cache is tied to the installed source files, so every fresh install pays the compile
-once; ``make`` pays it at install time (``python -m suds_exp.sim.precompile``) so that
-the first ``suds-exp simulate`` a user runs does not.
+cache is tied to the simulator's source files (a hash of every module of `suds_exp.sim`,
+`sim/_jit.py`), so every fresh install or change of the simulator pays the compile once;
+``make`` pays it at install time (``python -m suds_exp.sim.precompile``) so that the
+first ``suds-exp simulate`` a user runs does not.
 """
 
 from __future__ import annotations

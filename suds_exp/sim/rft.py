@@ -19,8 +19,10 @@ Each step solves at the midpoint of the joint path (phi interpolated linearly be
 samples, d(phi)/dt the secant), flipper angles predicted half a step ahead; the pose is
 advanced with the SE(2) exponential of the twist.
 
-Per-trial parameters come in a vector `prm` of N_PARAMS (indices P_*), packed by
-`suds_exp.sim.mechanics.pack_params` in the scaled units above; body inertia relaxes the
+The forces and their Jacobian are `sim/forces.py`'s; this module solves and steps them.
+Per-trial parameters come in a vector `prm` (indices P_*, the slots that
+`suds_exp.sim.effect_params` declares), packed by `suds_exp.sim.mechanics.pack_params`
+in the scaled units above; body inertia relaxes the
 twist towards the quasi-static one with factor 1 - exp(-h / tau) per step.
 """
 
@@ -29,262 +31,43 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
 
-P_CS, P_CF, P_CL, P_GAMMA, P_EPS, P_MU = 0, 1, 2, 3, 4, 5
-P_ASYM, P_NORMAL, P_COMPACT = 6, 7, 8
-P_K, P_PRELOAD, P_AMAX, P_CHINGE = 9, 10, 11, 12
-P_FLMODE, P_FLLOCK, P_TAU = 13, 14, 15
-P_TOL, P_MAXIT, P_SFLOOR, P_LREF, P_SUBSTEPS = 16, 17, 18, 19, 20
-# servo gain (scaled torque per rad, 0 = joints follow the given angles), stall torque
-# (scaled), back-EMF damping (scaled torque s/rad); hinge friction torques of flippers 1-4
-P_SGAIN, P_STALL, P_SDAMP = 21, 22, 23
-P_HFRIC = 24
-# grain-scale contact fluctuations: log-sd of each element's drag multiplier and the
-# share of its log-variance common to its whole part (the slip correlation length is in
-# the modes' wavenumbers)
-P_GSIG, P_GCOH = 28, 29
-N_PARAMS = 30
-N_PARTS = 7
+from suds_exp.sim._jit import njit, prange
+from suds_exp.sim.forces import (
+    FL_ABSENT,
+    FL_FREE,
+    N_PARTS,
+    N_UNKNOWN,
+    P_AMAX,
+    P_CHINGE,
+    P_COMPACT,
+    P_EPS,
+    P_FLLOCK,
+    P_FLMODE,
+    P_GCOH,
+    P_GSIG,
+    P_HFRIC,
+    P_LREF,
+    P_MAXIT,
+    P_NORMAL,
+    P_SDAMP,
+    P_SFLOOR,
+    P_SGAIN,
+    P_STALL,
+    P_SUBSTEPS,
+    P_TAU,
+    P_TOL,
+    assemble,
+    element_geometry,
+)
+
 # joint rate below which a servo loaded by the beans counts as stuck (rad/s)
 SERVO_STICK_RATE = 0.05
 # time constant (s) over which a servo's load follows the medium's torque
 SERVO_LOAD_TAU = 0.03
-HALF_MID = 0.5
-
-FL_FREE, FL_LOCKED, FL_ABSENT = 0, 1, 2
-N_UNKNOWN = 7
 # Newton step caps in scaled units (velocity / (L_ref * shape rate), hinge rate / shape rate)
 STEP_BODY = 0.1
 STEP_HINGE = 1.0
-
-
-@njit(cache=True)
-def _element_geometry(phi1, phi2, dphi1, dphi2, ang, body, geo):
-    """Positions, axes, hinge columns and shape-driven velocities of all elements.
-
-    body: the elements' description (el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy,
-    fl_side; see `run_trials`). geo: array (n_el, 9) filled with px, py, tx, ty, bx, by,
-    cx, cy, hinge index (body frame, units of L_ref; b = velocity per unit hinge rate,
-    c = velocity from the shape rate).
-    """
-    el_part, el_s, half_mid, fl_seg, fl_hx, fl_hy, fl_side = body
-    c1, s1 = math.cos(phi1), math.sin(phi1)
-    c2, s2 = math.cos(-phi2), math.sin(-phi2)
-    for e in range(el_part.shape[0]):
-        part = el_part[e]
-        s = el_s[e]
-        hidx = -1
-        if part < 3:
-            seg = part
-            sx, sy = s, 0.0
-            ax, ay = 1.0, 0.0
-        else:
-            hidx = part - 3
-            seg = fl_seg[hidx]
-            side = fl_side[hidx]
-            a = ang[hidx]
-            dx, dy = -math.cos(a), side * math.sin(a)
-            sx = fl_hx[hidx] + s * dx
-            sy = fl_hy[hidx] + s * dy
-            ax, ay = dx, dy
-        if seg == 0:
-            ox, cs, sn, rate = half_mid, c1, s1, dphi1
-        elif seg == 2:
-            ox, cs, sn, rate = -half_mid, c2, s2, -dphi2
-        else:
-            ox, cs, sn, rate = 0.0, 1.0, 0.0, 0.0
-        rx = cs * sx - sn * sy
-        ry = sn * sx + cs * sy
-        px = ox + rx
-        py = ry
-        geo[e, 0] = px
-        geo[e, 1] = py
-        geo[e, 2] = cs * ax - sn * ay
-        geo[e, 3] = sn * ax + cs * ay
-        # segment rotation about its joint at `rate` (rad/s per unit shape rate)
-        geo[e, 6] = -rate * ry
-        geo[e, 7] = rate * rx
-        if hidx >= 0:
-            hx = ox + cs * fl_hx[hidx] - sn * fl_hy[hidx]
-            hy = sn * fl_hx[hidx] + cs * fl_hy[hidx]
-            # flipper turns at -side * u relative to its segment (opening is outwards)
-            w = -fl_side[hidx]
-            geo[e, 4] = -w * (py - hy)
-            geo[e, 5] = w * (px - hx)
-        else:
-            geo[e, 4] = 0.0
-            geo[e, 5] = 0.0
-        geo[e, 8] = hidx
-
-
-@njit(cache=True, inline="always")
-def _element_drag(w, vp, vn, e2, cf, cl, cs, gam, mu, rho, asym, want_j):
-    """Smoothed granular RFT force on one element of weight w moving at (vp, vn) along
-    its tangent and normal (scaled units; smoothing e2 = eps^2): (fpar, fper) and, if
-    want_j, its derivatives (a11 = dfpar/dvp, a12 = dfpar/dvn, a21, a22) (else zeros).
-    ``asym``: the element belongs to a segment, whose parallel drag is rho times larger
-    sliding forward (towards the head) than backward."""
-    V2 = vp * vp + vn * vn + e2
-    V = math.sqrt(V2)
-    Ru = math.sqrt(vp * vp + e2)
-    Rw = math.sqrt(vn * vn + e2)
-    p1 = vp / V
-    g = vp / Ru
-    sn = Rw / V
-    p2 = g * (1.0 - sn)
-    q = vn / V
-    gq = math.sqrt(1.0 + gam * gam * q * q)
-    hq = gam * q / gq
-    if asym:
-        # rho when sliding forward (towards the head), 1 when sliding backward
-        m = 0.5 * (1.0 + rho) + 0.5 * (rho - 1.0) * g
-    else:
-        m = 1.0
-    fpar = -w * ((cf * p1 + cl * p2) * m + mu * vp)
-    fper = -w * (cs * hq + mu * vn)
-    if not want_j:
-        return fpar, fper, 0.0, 0.0, 0.0, 0.0
-    V3 = V2 * V
-    dp1_p = (vn * vn + e2) / V3
-    dp1_n = -vp * vn / V3
-    dg_p = e2 / (Ru * Ru * Ru)
-    dsn_p = -Rw * vp / V3
-    dsn_n = vn / (Rw * V) - Rw * vn / V3
-    dp2_p = dg_p * (1.0 - sn) - g * dsn_p
-    dp2_n = -g * dsn_n
-    dq_p = -vn * vp / V3
-    dq_n = (vp * vp + e2) / V3
-    dh = gam / (gq * gq * gq)
-    dm_p = 0.0
-    if asym:
-        dm_p = 0.5 * (rho - 1.0) * dg_p
-    a11 = -w * ((cf * dp1_p + cl * dp2_p) * m + (cf * p1 + cl * p2) * dm_p + mu)
-    a12 = -w * (cf * dp1_n + cl * dp2_n) * m
-    a21 = -w * cs * dh * dq_p
-    a22 = -w * (cs * dh * dq_n + mu)
-    return fpar, fper, a11, a12, a21, a22
-
-
-@njit(cache=True, inline="always")
-def _add_element_jacobian(J, a11, a12, a21, a22, tx, ty, px, py, bxh, byh, h):
-    """Add one element's part of the Jacobian: its drag derivatives (a, in its tangent /
-    normal frame t = (tx, ty)) through its velocity's dependence on the body twist
-    (position px, py) and on hinge h's rate (column b = (bxh, byh); h < 0: none)."""
-    nx = -ty
-    ny = tx
-    # body-frame 2x2: M D M^T with M = [t n]
-    b11 = tx * (a11 * tx + a12 * nx) + nx * (a21 * tx + a22 * nx)
-    b12 = tx * (a11 * ty + a12 * ny) + nx * (a21 * ty + a22 * ny)
-    b21 = ty * (a11 * tx + a12 * nx) + ny * (a21 * tx + a22 * nx)
-    b22 = ty * (a11 * ty + a12 * ny) + ny * (a21 * ty + a22 * ny)
-    # element velocity Jacobian rows over columns (0, 1, 2, 3+h)
-    bx2 = -py
-    by2 = px
-    # dF/dx = D B  (2 x 4)
-    d0x, d0y = b11, b21
-    d1x, d1y = b12, b22
-    d2x = b11 * bx2 + b12 * by2
-    d2y = b21 * bx2 + b22 * by2
-    dhx = b11 * bxh + b12 * byh
-    dhy = b21 * bxh + b22 * byh
-    # rows: B^T (dF/dx); row 2 is the torque px*fy - py*fx
-    J[0, 0] += d0x
-    J[0, 1] += d1x
-    J[0, 2] += d2x
-    J[1, 0] += d0y
-    J[1, 1] += d1y
-    J[1, 2] += d2y
-    J[2, 0] += px * d0y - py * d0x
-    J[2, 1] += px * d1y - py * d1x
-    J[2, 2] += px * d2y - py * d2x
-    if h >= 0:
-        c = 3 + h
-        J[0, c] += dhx
-        J[1, c] += dhy
-        J[2, c] += px * dhy - py * dhx
-        J[c, 0] += bxh * d0x + byh * d0y
-        J[c, 1] += bxh * d1x + byh * d1y
-        J[c, 2] += bxh * d2x + byh * d2y
-        J[c, c] += bxh * dhx + byh * dhy
-
-
-@njit(cache=True)
-def _hinge_rows(x, prm, e2, held, ang, c_hinge, R, J, want_j, qh):
-    """The hinge equations' own terms: a held hinge's row becomes u = 0 (the stop takes
-    the torque); a free one adds its spring, damping and smoothed Coulomb friction."""
-    k = prm[P_K]
-    pre = prm[P_PRELOAD]
-    for i in range(4):
-        c = 3 + i
-        if held[i]:
-            qh[i] += -k * (ang[i] + pre)
-            R[c] = x[c]
-            if want_j:
-                for j in range(N_UNKNOWN):
-                    J[c, j] = 0.0
-                J[c, c] = 1.0
-        else:
-            # Coulomb friction, smoothed like the medium's sign functions
-            u = x[c]
-            fr = prm[P_HFRIC + i]
-            ru = math.sqrt(u * u + e2)
-            spring = -k * (ang[i] + pre) - c_hinge * u - fr * u / ru
-            R[c] += spring
-            qh[i] += spring
-            if want_j:
-                J[c, c] += -c_hinge - fr * e2 / (ru * ru * ru)
-
-
-@njit(cache=True)
-def _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, want_j, qh):
-    """Residual R(x) (7,) and, if want_j, Jacobian J (7, 7); qh (7,) gets the hinge
-    generalised torques at the current x in 0..3 (used to release a held hinge) and the
-    medium's torque about the head and tail joints on the head and tail segments with
-    their flippers in 4, 5 (the load of the servos), counter-clockwise positive."""
-    cs = prm[P_CS] * normal_fac
-    e2 = eps * eps
-    for i in range(N_UNKNOWN):
-        R[i] = 0.0
-        if want_j:
-            for j in range(N_UNKNOWN):
-                J[i, j] = 0.0
-    for i in range(6):
-        qh[i] = 0.0
-    for e in range(el_part.shape[0]):
-        w = el_w[e]
-        if w == 0.0:
-            continue
-        px, py, tx, ty = geo[e, 0], geo[e, 1], geo[e, 2], geo[e, 3]
-        h = int(geo[e, 8])
-        uh = 0.0
-        if h >= 0:
-            uh = x[3 + h]
-        vx = x[0] - x[2] * py + geo[e, 4] * uh + geo[e, 6]
-        vy = x[1] + x[2] * px + geo[e, 5] * uh + geo[e, 7]
-        vp = vx * tx + vy * ty
-        vn = vx * -ty + vy * tx
-        part = el_part[e]
-        fpar, fper, a11, a12, a21, a22 = _element_drag(
-            w, vp, vn, e2, prm[P_CF], prm[P_CL], cs, prm[P_GAMMA], prm[P_MU], prm[P_ASYM],
-            part < 3, want_j,
-        )  # fmt: skip
-        fx = fpar * tx + fper * -ty
-        fy = fpar * ty + fper * tx
-        R[0] += fx
-        R[1] += fy
-        R[2] += px * fy - py * fx
-        if part == 0 or part == 3 or part == 4:
-            qh[4] += (px - HALF_MID) * fy - py * fx
-        elif part == 2 or part == 5 or part == 6:
-            qh[5] += (px + HALF_MID) * fy - py * fx
-        if h >= 0:
-            qq = geo[e, 4] * fx + geo[e, 5] * fy
-            R[3 + h] += qq
-            qh[h] += qq
-        if want_j:
-            _add_element_jacobian(J, a11, a12, a21, a22, tx, ty, px, py, geo[e, 4], geo[e, 5], h)
-    _hinge_rows(x, prm, e2, held, ang, c_hinge, R, J, want_j, qh)
 
 
 @njit(cache=True)
@@ -346,7 +129,7 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
     qh = work[4]
     J = np.empty((N_UNKNOWN, N_UNKNOWN))
     Jt = np.empty((N_UNKNOWN, N_UNKNOWN))
-    _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+    assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
     nr = _norm(R)
     it = 0
     while nr > tol and it < max_iter:
@@ -369,7 +152,7 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
         while t > 1e-3:
             for i in range(N_UNKNOWN):
                 xt[i] = x[i] + t * dx[i]
-            _assemble(
+            assemble(
                 xt,
                 geo,
                 el_w,
@@ -392,7 +175,7 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
             t *= 0.25
         if not accepted:
             # stalled at a kink of the smoothed law: the caller continues on eps
-            _assemble(
+            assemble(
                 x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh
             )
             return nr, it
@@ -404,7 +187,7 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
                 for j in range(N_UNKNOWN):
                     J[i, j] = Jt[i, j]
         else:
-            _assemble(
+            assemble(
                 x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh
             )
         nr = _norm(R)
@@ -424,7 +207,7 @@ def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, ma
     Jd = np.empty((N_UNKNOWN, N_UNKNOWN))
     A = np.empty((N_UNKNOWN, N_UNKNOWN))
     g = np.empty(N_UNKNOWN)
-    _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+    assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
     nr = _norm(R)
     lam = 1e-6
     it = 0
@@ -449,7 +232,7 @@ def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, ma
             if _lin_solve(Jd, g, dx):
                 for i in range(N_UNKNOWN):
                     xt[i] = x[i] + dx[i]
-                _assemble(
+                assemble(
                     xt,
                     geo,
                     el_w,
@@ -475,7 +258,7 @@ def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, ma
         lam = max(lam / 5.0, 1e-9)
         for i in range(N_UNKNOWN):
             x[i] = xt[i]
-        _assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+        assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
         nr = _norm(R)
     return nr, it
 
@@ -860,7 +643,7 @@ def _substep(phi_k, f, fa, fb, p, state, trial, body, buf, bed_k, grain_k):
     d2 = (b2 - a2) / h
     s = math.sqrt(d1 * d1 + d2 * d2 + p[P_SFLOOR] * p[P_SFLOOR])
     _flipper_midpoints(ang, uprev, held, h, amax, mode, amid)
-    _element_geometry(0.5 * (a1 + b1), 0.5 * (a2 + b2), d1 / s, d2 / s, amid, body, geo)
+    element_geometry(0.5 * (a1 + b1), 0.5 * (a2 + b2), d1 / s, d2 / s, amid, body, geo)
     has_bed = half_var[0] > 0.0 or half_var[1] > 0.0 or bed_scale != 1.0
     _bed_weights(w_eff, geo, bed_k, bed_scale, half_var, has_bed, X, Y, TH, lref, w_bed)
     if grains:
@@ -990,7 +773,7 @@ def run_trials(
 
     phi: (n_trials, n_frames, 2) rad, sampled every dt s; n_steps[k] frames used by
     trial k: the joint angles, or the servo command when prm[k, P_SGAIN] > 0. pose0
-    (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, N_PARAMS); bed
+    (n_trials, 3) mm, rad; ang0 (n_trials, 4) rad; prm (n_trials, n_params); bed
     (n_trials, n_modes, 4) random Fourier modes of the bed (kx, ky in 1/mm, phase,
     amplitude; see bed.py) and bed_scale (n_trials,) its trial factor; grains (n_trials,
     n_el + N_PARTS, n_modes, 2) the grain contacts' random modes in slip distance (see
@@ -1044,7 +827,7 @@ def solve_twists(
     for n in range(phis.shape[0]):
         d1, d2 = dphis[n, 0], dphis[n, 1]
         s = math.sqrt(d1 * d1 + d2 * d2 + prm[P_SFLOOR] * prm[P_SFLOOR])
-        _element_geometry(phis[n, 0], phis[n, 1], d1 / s, d2 / s, ang, body, geo)
+        element_geometry(phis[n, 0], phis[n, 1], d1 / s, d2 / s, ang, body, geo)
         for i in range(N_UNKNOWN):
             x[i] = 0.0
         nr, _, _ = _solve_step(x, geo, w_eff, el_part, prm, prm[P_NORMAL], held, ang, 0.0, work)

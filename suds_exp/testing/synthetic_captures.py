@@ -5,7 +5,8 @@ follows a prescribed smooth body velocity, and the flippers open and close with 
 phase. Markers sit on rigid segments at fixed places (different from the simulator's, so
 nothing downstream can rely on one particular placement), the motion plane is tilted
 and offset in the capture volume, and the tracks get noise, jumps and dropouts. The truth
-frame has the simulator truth file's columns.
+frame has the simulator truth file's columns. `qtm_text` and `random_track` make a
+QTM TSV export of plain random tracks (for the readers' tests and the ingest benchmark).
 """
 
 from __future__ import annotations
@@ -240,3 +241,36 @@ def write_dataset(
     manifest = folder / "manifest.csv"
     pd.DataFrame(rows).to_csv(manifest, index=False)
     return manifest
+
+
+def qtm_text(names: list[str], xyz: np.ndarray, rate: float = 100.0, crlf: bool = True) -> str:
+    """A QTM 3D TSV export of ``xyz`` (n_frames, n_markers, 3) mm; NaN -> 0 0 0."""
+    n_frames = xyz.shape[0]
+    head = [
+        f"NO_OF_FRAMES\t{n_frames}",
+        "NO_OF_CAMERAS\t4",
+        f"NO_OF_MARKERS\t{len(names)}",
+        f"FREQUENCY\t{rate:g}",
+        "NO_OF_ANALOG\t0",
+        "ANALOG_FREQUENCY\t0",
+        "DESCRIPTION\t--",
+        "TIME_STAMP\t2026-01-01, 10:00:00.000\t0.0",
+        "DATA_INCLUDED\t3D",
+        "MARKER_NAMES\t" + "\t".join(names),
+        "TRAJECTORY_TYPES\t" + "\t".join(["Mixed"] * len(names)),
+        "Frame\tTime\t" + "\t".join(f"{n} {a}" for n in names for a in "XYZ") + "\t",
+    ]
+    values = np.nan_to_num(xyz, nan=0.0).reshape(n_frames, -1)
+    rows = [
+        f"{i + 1}\t{i / rate:.5f}\t" + "\t".join(f"{v:.3f}" for v in row) + "\t"
+        for i, row in enumerate(values)
+    ]
+    return ("\r\n" if crlf else "\n").join(head + rows) + ("\r\n" if crlf else "\n")
+
+
+def random_track(n_frames: int, n_markers: int, seed: int = 0) -> np.ndarray:
+    """Smooth random marker tracks, shape (n_frames, n_markers, 3), mm."""
+    rng = np.random.default_rng(seed)
+    base = rng.uniform(-300, 300, size=(1, n_markers, 3))
+    drift = np.cumsum(rng.normal(0, 0.5, size=(n_frames, n_markers, 3)), axis=0)
+    return np.round(base + drift, 3)
