@@ -236,3 +236,19 @@ def test_a_sparse_campaign_still_reports_and_says_what_it_could_not_estimate(tmp
     assert "Not the paper's references" in page and "Not estimable" in page
     for ref in re.findall(r'(?:src|href)="([^"#]*)"', page):
         assert (tmp_path / "rep" / ref).is_file(), ref
+
+
+def test_the_report_columns_alone_give_the_tables_of_every_column(report):
+    """`write_report` loads `REPORT_COLUMNS` only: every table (findings with their
+    seeded intervals included) is the one of the frame with all analysis columns."""
+    from suds_exp.analysis import load_results, report_tables
+    from suds_exp.analysis.report import REPORT_COLUMNS
+
+    store = Store(report["db"])
+    full = report_tables(load_results(store, "demo"), findings_boot=20)
+    few = load_results(store, "demo", columns=REPORT_COLUMNS)
+    assert "campaign" not in few and "gait_steps" not in few
+    lean = report_tables(few, findings_boot=20, campaign="demo")
+    assert list(lean) == list(full) and lean.missing == full.missing
+    for name in full:
+        pd.testing.assert_frame_equal(lean[name], full[name], check_exact=True)

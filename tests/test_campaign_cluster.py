@@ -69,6 +69,23 @@ def _wait_for(address: str, n_workers: int) -> None:
         client.wait_for_workers(n_workers, timeout=60)
 
 
+def _n_tasks(dask_scheduler) -> int:
+    return len(dask_scheduler.tasks)
+
+
+def _wait_for_tasks(address: str, child: subprocess.Popen, timeout_s: float = 180) -> None:
+    """Until the run's client has given the scheduler tasks (a loaded machine takes its
+    time to start ``suds-exp run``: a fixed wait would kill the cluster before it connects)."""
+    from dask.distributed import Client
+
+    with Client(address, timeout=30) as client:
+        deadline = time.monotonic() + timeout_s
+        while client.run_on_scheduler(_n_tasks) == 0:
+            assert child.poll() is None, child.communicate()
+            assert time.monotonic() < deadline, "the run gave the scheduler no task"
+            time.sleep(0.2)
+
+
 @pytest.fixture(scope="module")
 def version_db(tmp_path_factory) -> Path:
     pytest.importorskip("dask.distributed")
@@ -100,7 +117,8 @@ def test_a_killed_worker_and_a_killed_scheduler_lose_nothing(tmp_path, version_d
         cmd = [str(BIN / "suds-exp"), *RUN, "--db", str(db), "--backend", "dask"]
         cmd += ["--scheduler", address]
         child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        time.sleep(5)
+        _wait_for_tasks(address, child)
+        time.sleep(2)
         _kill(workers[0])  # its jobs go to the other worker
         time.sleep(5)
         assert child.poll() is None, child.communicate()

@@ -171,3 +171,29 @@ def test_a_worker_with_the_nannys_trim_threshold_stops_faulting_its_arrays_in(tm
             assert int(fixed) > 20_000 and int(after) < 1_000, out.stdout
         else:
             assert int(fixed) < 1_000, out.stdout
+
+
+def _profiles(dask_worker) -> bool:
+    return "profile" in dask_worker.periodic_callbacks
+
+
+def test_a_preloaded_dask_worker_runs_no_statistical_profiler():
+    """Workers started with the preload (as the local cluster and the how-to start them)
+    do not sample their task thread's stack; others do (the check can fail)."""
+    pytest.importorskip("distributed")
+    from dask.distributed import Client, LocalCluster
+
+    ran = {}
+    for preload in ([], ["suds_exp.campaign.dask_worker"]):
+        with (
+            LocalCluster(
+                n_workers=1,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                preload=preload,
+            ) as cluster,
+            Client(cluster) as client,
+        ):
+            ran[bool(preload)] = list(client.run(_profiles).values())
+    assert ran == {False: [True], True: [False]}

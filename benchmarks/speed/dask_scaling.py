@@ -1,6 +1,7 @@
 """One campaign in-process, on 2 loky workers and on a real dask cluster over TCP, side by
-side in one run: wall time, speed-up, each job's own fit+predict time, the workers' CPU
-time, and whether the rows agree.
+side in one run: wall time, speed-up, each job's own fit+predict time, where the CPU time
+of a dask run goes (the ``suds-exp run`` client, the scheduler, the workers), and whether
+the rows agree.
 
 Usage::
 
@@ -19,7 +20,11 @@ dask's nanny process), stopped after each run.
 ``--worker-env`` sets environment variables of the dask workers only (to test what slows
 them down). Figures are medians over
 ``--rounds``; "job" is a job's ``fit_seconds + predict_seconds`` as the results table
-stores it. ``--quick``: phase-only, one draw of 2 cycles, one dask worker (a smoke run).
+stores it; "client CPU" is the ``suds-exp run`` process's CPU time (user + system, its
+start-up included: imports, samples, plan; ~3 s on a 2-core machine) and
+its share of the CPU time of the client, the scheduler and the workers together during
+the run (read from ``/proc``, so dask rows only, on Linux). ``--quick``: phase-only, one
+draw of 2 cycles, one dask worker (a smoke run).
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ import argparse
 import hashlib
 import json
 import os
+import resource
 import shutil
 import socket
 import subprocess
@@ -135,9 +141,24 @@ class _Cluster:
                 p.wait(timeout=30)
 
 
-def _run(base: Path, folder: Path, label: str, a, extra: list[str]) -> dict:
+def _cpu_s(pid: int) -> float:
+    """User + system CPU seconds of process ``pid`` so far (Linux ``/proc``; NaN elsewhere)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+    except OSError:
+        return float("nan")
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _run(
+    base: Path, folder: Path, label: str, a, extra: list[str], cluster: _Cluster | None = None
+) -> dict:
     db = folder / f"{label}.duckdb"
     shutil.copy(base, db)
+    pids = [p.pid for p in [cluster.scheduler, *cluster.workers]] if cluster else []
+    others = [_cpu_s(p) for p in pids]
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
     args = [
         "run",
         "c",
@@ -154,6 +175,10 @@ def _run(base: Path, folder: Path, label: str, a, extra: list[str]) -> dict:
         *extra,
     ]
     summary = json.loads(_suds(*args))
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    # the run's process and, with loky, its workers (reaped by it)
+    client = (after.ru_utime + after.ru_stime) - (children.ru_utime + children.ru_stime)
+    cluster_cpu = sum(_cpu_s(p) - c for p, c in zip(pids, others, strict=True))
     with duckdb.connect(str(db), read_only=True) as con:
         job = con.sql("SELECT median(fit_seconds + predict_seconds) FROM results").fetchone()[0]
         rows = con.sql(
@@ -166,6 +191,8 @@ def _run(base: Path, folder: Path, label: str, a, extra: list[str]) -> dict:
         "job_ms": 1000 * job,
         "jobs": summary["total_jobs"],
         "digest": digest,
+        "client_cpu": client,
+        "share": client / (client + cluster_cpu) if cluster else float("nan"),
     }
 
 
@@ -201,6 +228,7 @@ def main(argv=None) -> int:
                         f"dask{n}",
                         a,
                         ["--backend", "dask", "--scheduler", cluster.address, "-j", str(n)],
+                        cluster,
                     )
                 finally:
                     cluster.stop()
@@ -212,13 +240,18 @@ def main(argv=None) -> int:
         f"{a.rounds} round(s), medians; worker env {env or 'default'}; "
         f"{'with' if a.nanny else 'no'} nanny"
     )
-    print(f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11}  rows")
+    print(
+        f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11} "
+        f"{'client CPU s':>12} {'share':>6}  rows"
+    )
     for label, rs in runs.items():
         wall, job = median(r["wall"] for r in rs), median(r["job_ms"] for r in rs)
+        client, share = median(r["client_cpu"] for r in rs), median(r["share"] for r in rs)
+        share_text = f"{share:6.1%}" if share == share else f"{'':6}"
         same = "same" if {r["digest"] for r in rs} == {ref[0]["digest"]} else "DIFFER"
         print(
             f"{label:26} {wall:7.1f} {ref_wall / wall:7.2f}x {job:7.1f} {job / ref_job:10.2f}x "
-            f" {same}"
+            f"{client:12.2f} {share_text}  {same}"
         )
     return 0
 

@@ -43,9 +43,13 @@ def main_cycles(results: pd.DataFrame) -> int:
 
 
 def at_cycles(results: pd.DataFrame, n_cycles: int | None) -> tuple[pd.DataFrame, int]:
-    """The rows at ``n_cycles`` training cycles (default `main_cycles`), and that size."""
+    """The rows at ``n_cycles`` training cycles (default `main_cycles`), and that size
+    (``results`` itself when every row is at that size: callers do not change it)."""
     size = main_cycles(results) if n_cycles is None else int(n_cycles)
-    rows = results[results["n_cycles"] == size]
+    at = (results["n_cycles"] == size).to_numpy()
+    # a campaign without a sweep has every row at one size: the frame itself, not a copy
+    # of every loaded column
+    rows = results if at.all() else results[at]
     if rows.empty:
         sizes = ", ".join(str(v) for v in sorted(results["n_cycles"].unique()))
         raise AnalysisError(

@@ -579,7 +579,9 @@ def findings_table(
         raise AnalysisError(f"n_boot {n_boot!r}: expected an integer >= 0", param="n_boot")
     if not 0 < confidence < 1:
         raise AnalysisError(f"confidence {confidence!r}: expected a number in (0, 1)")
-    results = results[np.isfinite(results["rmse_vx"].to_numpy(float))]
+    finite = np.isfinite(results["rmse_vx"].to_numpy(float))
+    if not finite.all():  # `load_results` gives finite rows only: then no copy of them
+        results = results[finite]
     data = _draw_frame(results, upper_from)
     name = campaign if campaign is not None else str(results["campaign"].iloc[0])
     rng = np.random.default_rng(_seed(name, seed))

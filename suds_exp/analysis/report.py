@@ -16,7 +16,12 @@ import pandas as pd
 from suds_exp.analysis import plots
 from suds_exp.analysis.categories import at_cycles, category_table, learner_order
 from suds_exp.analysis.design_report import skipped_html, write_design_report
-from suds_exp.analysis.findings import findings_display, findings_headline, findings_table
+from suds_exp.analysis.findings import (
+    FINDINGS_COLUMNS,
+    findings_display,
+    findings_headline,
+    findings_table,
+)
 from suds_exp.analysis.formatting import (
     ReportTables,
     not_computed_html,
@@ -43,6 +48,11 @@ from suds_exp.store import Store
 from suds_exp.store.files import check_writable
 
 _SAFE_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
+#: The columns of ``results_labelled`` the report's tables and figures read: the findings'
+#: (`FINDINGS_COLUMNS`, but the campaign's name, which is given) and the categories' and
+#: spread's two more. `write_report` loads no others (at 10M results a column of numbers
+#: or of label references is 80 MB).
+REPORT_COLUMNS = tuple(c for c in FINDINGS_COLUMNS if c != "campaign") + ("freq_sim", "ln_rmse_vx")
 
 
 def report_tables(
@@ -52,8 +62,10 @@ def report_tables(
     upper_from: int | None = None,
     pairs: str = "same-condition",
     findings_boot: int = 400,
+    campaign: str | None = None,
 ) -> ReportTables:
-    """Every table of the report, from labelled results (see `load_results`).
+    """Every table of the report, from labelled results (see `load_results`; the
+    columns `REPORT_COLUMNS` are enough, with ``campaign`` given).
 
     Keys: ``findings`` (the paper's findings F1-F10, see `findings_table`, with
     ``findings_boot`` bootstrap replicates), ``categories``, ``glm`` (100 ln scale),
@@ -62,13 +74,17 @@ def report_tables(
     else in the default folder, which may not), ``compare_glm``
     (both scales, column ``scale``), ``compare_iqr`` and ``agreement``. A part that the
     results cannot support (no same-condition pairs, too few results for a GLM) is left
-    out, and ``missing`` says why. ``pairs``: see `iqr_table`.
+    out, and ``missing`` says why. ``pairs``: see `iqr_table`. ``campaign``: the name
+    the findings' seed mixes in (default the ``campaign`` column's first value).
     """
     if pairs not in PAIRS:
         raise AnalysisError(f"pairs {pairs}: expected one of {', '.join(PAIRS)}", param="pairs")
     tables = ReportTables()
     tables.attempt(
-        "findings", lambda: findings_table(results, n_boot=findings_boot, upper_from=upper_from)
+        "findings",
+        lambda: findings_table(
+            results, n_boot=findings_boot, upper_from=upper_from, campaign=campaign
+        ),
     )
     tables.attempt("categories", lambda: category_table(results, n_cycles))
     tables.attempt("glm", lambda: glm_table(results, n_cycles, response="log"))
@@ -199,10 +215,10 @@ def write_report(
     design = design_for(store, design)
     if not is_paper(design):
         return write_design_report(store, campaign, design, out, n_cycles)
-    results = load_results(store, campaign)
+    results = load_results(store, campaign, columns=REPORT_COLUMNS)
     _, size = at_cycles(results, n_cycles)
     out.mkdir(parents=True, exist_ok=True)
-    tables = report_tables(results, size, paper_dir, upper_from, pairs, n_boot)
+    tables = report_tables(results, size, paper_dir, upper_from, pairs, n_boot, campaign)
 
     figures = plots.category_boxplots(results, out, size)
     if "iqr" in tables:

@@ -11,6 +11,12 @@ process stops the run and closes the cluster, so a worker ignores SIGINT instead
 printing its own KeyboardInterrupt traceback. Its allocator is settled before any job
 (`suds_exp.campaign.job.settle_allocator`: the nanny's fixed trim threshold costs page
 faults in every job).
+
+It also turns off the worker's statistical profiler (``distributed.worker.profile``: a
+look at the task thread's stack every 10 ms, for the dashboard's profile page): on a
+2-worker cluster of 1,200 five-cycle jobs it took 7 % of the workers' CPU time (8.9-9.6 s
+against 9.5-10.2 s a worker, two rounds each, measured under load). The module is
+imported before the worker sets its periodic callbacks up, so the setting takes effect.
 """
 
 from __future__ import annotations
@@ -29,5 +35,12 @@ def dask_setup(worker) -> None:
     import suds_exp.models  # noqa: F401  (warm: see the module's docstring)
 
 
+def _quiet_profiler() -> None:
+    import dask
+
+    dask.config.set({"distributed.worker.profile.enabled": False})
+
+
 # importing happens before dask_setup, as early as a worker can act
+_quiet_profiler()
 dask_setup(None)

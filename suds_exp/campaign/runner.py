@@ -420,8 +420,10 @@ def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextli
 
         if scheduler:
             # a lost scheduler is one line (`ClusterLostError`), not the client's logged
-            # reconnect tracebacks
+            # reconnect tracebacks, nor tornado's of a result being gathered then (a
+            # callback of the client's loop: 45 lines, seen in the cluster test)
             stack.enter_context(_quiet_logger("distributed"))
+            stack.enter_context(_quiet_logger("tornado"))
             stack.enter_context(Client(scheduler, timeout=SCHEDULER_WAIT_S))
         else:
             with _sigint_blocked():
