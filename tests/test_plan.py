@@ -82,9 +82,10 @@ def test_next_map_recommends_declared_levels_with_reasons_and_a_stop_signal(db, 
         assert r["unit"] == "mm^2" and "prediction variance" in r["reason"]
         assert r["trial"]["cycles"] == 5 and r["trial"]["frequency_hz"] > 0
         assert r["trial"]["gait"] in ("S+", "S-", "O", "D-", "D+")
-    # the map goal judges the last doubling on the target: ten cycles are too few for it
+    # the map goal forecasts the next doubling: from one gait, far from flat
     stop = doc["stop"]
-    assert stop["stop"] is False and stop["message"].startswith("too few cycles")
+    assert stop["stop"] is False and stop["change_mm"] > stop["spread_mm"]
+    assert stop["message"].startswith("continue: the next doubling of cycles")
 
 
 def test_the_map_criterion_discounts_what_is_recorded_and_spreads_a_batch(small):
@@ -353,3 +354,29 @@ def test_a_recorded_path_at_one_third_hz_is_known_as_recorded():
     assert paths == [("D-", 0.5), ("O", 0.333333)]
     levels = {(g.name, round(f, 6)) for g, f in declared_levels()}
     assert set(paths) <= levels
+
+
+def test_the_map_stopping_signal_forecasts_the_next_doubling(small, three_paths):
+    from suds_exp.plan import MapEnsemble, forecast_signal
+    from suds_exp.plan.recommend import recommend_map
+    from suds_exp.preprocess import get_version
+
+    target = Target()
+    verdicts = {}
+    for name, db in (("one path", small), ("three paths", three_paths)):
+        samples = get_version(Store(db), "v1").samples()
+        ensemble = MapEnsemble.fit(samples, n_boot=3, seed=0)
+        signal = forecast_signal(samples, ensemble, target, 10)
+        # the doubling is spent on the trials the planner would choose: as many trials
+        # of 10 cycles as cycles are recorded, over 10
+        n = signal.cycles[0]
+        trials = recommend_map(ensemble, target, 10, max(1, round(n / 10)), samples)
+        assert signal.cycles == [n, n + 10 * len(trials)]
+        assert signal.stop == (signal.change_mm < signal.spread_mm)
+        assert signal.message.startswith("stop: " if signal.stop else "continue: ")
+        verdicts[name] = signal
+    # a map that has seen one gait errs elsewhere by the order of the motion itself, and a
+    # second path removes much of that: never a reason to stop
+    one, three = verdicts["one path"], verdicts["three paths"]
+    assert not one.stop, one.message
+    assert three.change_mm < one.change_mm

@@ -57,7 +57,7 @@ from suds_exp.gait.trials import gait_trial_specs
 from suds_exp.gait.truth import simulate_forward
 from suds_exp.ingest import ingest_paths
 from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop
-from suds_exp.plan.curve import latched, target_signal
+from suds_exp.plan.curve import forecast_signal, latched
 from suds_exp.plan.ensemble import MapEnsemble, block_draws
 from suds_exp.plan.recommend import Trial
 from suds_exp.plan.record import record_trial
@@ -167,7 +167,7 @@ def arm_plan(
             ens = MapEnsemble.fit(
                 part, opts.learner, opts.n_boot, derive_seed("plan-fit", loop.name, k)
             )
-            now = target_signal(part, ens, truth.target, opts.learner)
+            now = forecast_signal(part, ens, truth.target, opts.cycles, opts.learner)
             signal = now if k == 0 else latched(now, before, fired)
             before, fired = now, fired or signal.stop
             row["stop"], row["stop_reason"] = bool(signal.stop), signal.message
@@ -197,11 +197,24 @@ def flattening(rows: list[dict]) -> dict:
             flat = {"cycles": r["cycles"], "drop_mm": drop, "spread_mm": r["error_spread_mm"],
                     "doubled_at": later[0]["cycles"]}  # fmt: skip
             break
+    # the same test at every count: where it holds from then on (a single noisy count,
+    # such as the warm-up's with its wide spread, does not decide it)
+    tested = []
+    for r in rows:
+        later = [q for q in rows if q["cycles"] >= 2 * r["cycles"]]
+        if r["cycles"] > 0 and later:
+            drop = r["map_error_mm"] - later[0]["map_error_mm"]
+            tested.append((r["cycles"], bool(drop < r["error_spread_mm"])))
+    flat_from = next((c for i, (c, _) in enumerate(tested) if all(f for _, f in tested[i:])), None)
     fired = next((r["cycles"] for r in rows if r["stop"]), None)
-    within = None
+    within = within_from = None
     if flat is not None and fired is not None:
         within = abs(fired - flat["cycles"]) <= 0.2 * flat["cycles"]
-    return {"flattens_at": flat, "signal_first_at": fired, "within_20_percent": within}
+    if flat_from is not None and fired is not None:
+        within_from = abs(fired - flat_from) <= 0.2 * flat_from
+    return {"flattens_at": flat, "signal_first_at": fired, "within_20_percent": within,
+            "flat_from": flat_from, "within_20_percent_of_flat_from": within_from,
+            "tested": tested}  # fmt: skip
 
 
 def measured_forward(gait, cycles: int, seed: int, config: SimConfig) -> float:

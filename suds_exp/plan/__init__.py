@@ -4,16 +4,17 @@ gait closest, and when more data of a kind stops helping.
 Public face (the CLI's `plan next | loop` are thin faces on these):
 
 - `plan_next(store, prep, goal, Target(...))` (`advise`): the next trial(s), each with its
-  reason, and the stopping signal (the map goal's judged on the target).
+  reason, and the stopping signal (the map goal's forecast for the next doubling).
 - `run_loop(store, LoopOptions(...))` (`loop`): the closed loop with the simulator as the
   robot, every iteration stored (``plan_iterations``); rerunning continues it.
 - `MapEnsemble` (`ensemble`): a learner and its cycle-bootstrap refits, the uncertainty
-  every plan reads; `learning_curve`, `target_signal` (`curve`); `Target`,
+  every plan reads; `forecast_signal` (the map goal's stopping signal), `learning_curve`,
+  `target_signal` (`curve`); `Target`,
   `unseen_gaits` (`target`).
 """
 
 from suds_exp.plan.advise import Advice, plan_next
-from suds_exp.plan.curve import StopSignal, learning_curve, target_signal
+from suds_exp.plan.curve import StopSignal, forecast_signal, learning_curve, target_signal
 from suds_exp.plan.ensemble import MapEnsemble
 from suds_exp.plan.loop import Loop, LoopIteration, LoopOptions, load_loop, run_loop
 from suds_exp.plan.recommend import Recommendation, Trial
@@ -32,6 +33,7 @@ __all__ = [
     "TargetTruth",
     "Trial",
     "learning_curve",
+    "forecast_signal",
     "load_loop",
     "plan_next",
     "run_loop",

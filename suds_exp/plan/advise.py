@@ -11,10 +11,15 @@ from suds_exp.gait.predict import derive_seed
 from suds_exp.gait.support import Support
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
-from suds_exp.plan.curve import StopSignal, learning_curve, target_signal
+from suds_exp.plan.curve import StopSignal, forecast_signal, learning_curve
 from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
 from suds_exp.plan.loop import TRUST0, _recorded_gaits, check_body, version_cycles
-from suds_exp.plan.recommend import Recommendation, recommend_gait, recommend_map
+from suds_exp.plan.recommend import (
+    Recommendation,
+    bias_variance,
+    recommend_gait,
+    recommend_map,
+)
 from suds_exp.plan.target import GOALS, Target
 from suds_exp.preprocess import get_version
 from suds_exp.store import Store
@@ -84,7 +89,8 @@ def plan_next(
     ensemble = MapEnsemble.fit(samples, learner, n_boot, key)
     advice = Advice(version.id, goal, version_cycles(samples))
     if goal == "map":
-        advice.recommendations = recommend_map(ensemble, target, cycles, n, samples, learner)
+        bias = bias_variance(samples, target, learner, ensemble.point)
+        advice.recommendations = recommend_map(ensemble, target, cycles, n, samples, learner, bias)
     else:
         out = Path(out)
         name = f"plan-v{version.id}-{key % 10**6:06d}.toml"
@@ -104,7 +110,7 @@ def plan_next(
         advice.recommendations = [rec]
         advice.files = [str(path)]
     if goal == "map":
-        advice.stop = target_signal(samples, ensemble, target, learner)
+        advice.stop = forecast_signal(samples, ensemble, target, cycles, learner, bias)
     else:
         advice.stop = learning_curve(samples, learner, key)
     return advice

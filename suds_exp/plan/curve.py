@@ -11,7 +11,16 @@ The signal is plain: if the last doubling of cycles lowered the held-out error b
 than its spread, the next doubling (of the same kind of data) will not help more, since
 a learning curve flattens as it goes; say so.
 
-For the map goal the doubling is judged on the target itself (`target_signal`): the
+For the map goal the signal looks forward (`forecast_signal`), as the question is
+whether the next doubling of cycles will help: the planner's own model of the target's
+prediction variance (the bootstrap's noise plus the path jackknife's bias between paths,
+`suds_exp.plan.recommend`) says how much of it the trials it would choose for the next
+doubling remove; the expected error before and after is the root mean of that variance
+per target. If the expected drop is less than the bootstrap spread of the target's
+predictions, more data will not help more than noise can tell. Only the user's data
+enter (the target is the user's; nothing is simulated).
+
+`target_signal` judges the last doubling on the target instead: the
 map fitted on the first half of the recorded cycles and the map fitted on all of them
 predict the target's net displacement per cycle; if the last doubling moved those
 predictions by less than their bootstrap spread, the data of the second half did not
@@ -30,6 +39,7 @@ import pandas as pd
 from suds_exp.gait.predict import fit_map
 from suds_exp.models.registry import GMR
 from suds_exp.plan.ensemble import MapEnsemble, cycle_blocks
+from suds_exp.plan.recommend import bias_variance, recommend_map
 from suds_exp.plan.target import Target
 
 N_FOLDS = 4
@@ -170,6 +180,51 @@ def target_signal(
         )
     return StopSignal(stop, message, [float(half), float(len(blocks))], [], [], None,
                       change, spread)  # fmt: skip
+
+
+def forecast_signal(
+    samples: pd.DataFrame,
+    ensemble: MapEnsemble,
+    target: Target,
+    cycles: int,
+    learner: str = GMR,
+    bias: np.ndarray | None = None,
+) -> StopSignal:
+    """The map goal's stopping signal (see the module docstring): the expected drop (mm
+    per cycle) of the target's prediction error over the next doubling of the recorded
+    cycles, spent on the trials of ``cycles`` cycles `recommend_map` would choose, against
+    the RMS bootstrap standard deviation (mm) of ``ensemble``'s predictions there.
+
+    The expected error is sqrt(V / T) for the total variance V (mm^2: bootstrap noise plus
+    path-jackknife bias, ``bias`` when the caller has it) over T target pairs; after the
+    doubling V less what the chosen trials remove. ``change_mm`` is the drop,
+    ``spread_mm`` the spread, ``cycles`` [now, after the doubling]."""
+    pairs = target.pairs()
+    n = len(cycle_blocks(samples))
+    trials = max(1, round(n / cycles))
+    if bias is None:
+        bias = bias_variance(samples, target, learner, ensemble.point)
+    noise = np.array([ensemble.displacement_spread([g], f)[0] for g, f in pairs])
+    recs = recommend_map(ensemble, target, cycles, trials, samples, learner, bias)
+    total = float(noise.sum() + bias.sum())
+    removed = min(total, float(sum(r.score for r in recs)))
+    before = float(np.sqrt(total / len(pairs)))
+    after = float(np.sqrt((total - removed) / len(pairs)))
+    drop, spread = before - after, float(np.sqrt(noise.mean()))
+    doubling = (
+        f"the next doubling of cycles ({n} -> {n + len(recs) * cycles}, the {len(recs)} "
+        f"trials planned) is expected to lower the target's prediction error by {drop:.2f} "
+        f"mm per cycle ({before:.2f} -> {after:.2f})"
+    )
+    if drop < spread:
+        message = (
+            f"stop: {doubling}, less than its bootstrap spread {spread:.2f} mm; more data "
+            "of this kind will not help"
+        )
+    else:
+        message = f"continue: {doubling}, more than its bootstrap spread {spread:.2f} mm"
+    return StopSignal(drop < spread, message, [float(n), float(n + len(recs) * cycles)],
+                      [], [], None, drop, spread)  # fmt: skip
 
 
 def latched(now: StopSignal, before: StopSignal | None, fired: bool) -> StopSignal:

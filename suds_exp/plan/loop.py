@@ -5,8 +5,8 @@ simulate with the trial's seed, ingest, preprocess into the version), refits the
 with its bootstrap refits, and stores one row of ``plan_iterations`` (migration 022):
 the trial and its reason, the cycles recorded so far, the map's error on the target set,
 the best recorded gait and its predicted and simulator-achieved forward displacement per
-cycle, the stopping signal (the map goal's judged on the target and latched, the gait
-goal's the learning curve's: `suds_exp.plan.curve`) and the gait goal's trust radius.
+cycle, the stopping signal (the map goal's forecast for the next doubling and latched,
+the gait goal's the learning curve's: `suds_exp.plan.curve`) and the gait goal's trust radius.
 
 Budget: the cycles the loop records, its warm-up included. A loop starts from a warm-up
 recording (`LoopOptions.warmup_gait` at `warmup_frequency_hz`, `warmup_cycles` cycles)
@@ -44,9 +44,15 @@ from suds_exp.ingest import stored_design, trial_level_axis
 from suds_exp.ingest.added import mark_trials_added
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
-from suds_exp.plan.curve import latched, learning_curve, target_signal
+from suds_exp.plan.curve import forecast_signal, latched, learning_curve
 from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
-from suds_exp.plan.recommend import Recommendation, Trial, recommend_gait, recommend_map
+from suds_exp.plan.recommend import (
+    Recommendation,
+    Trial,
+    bias_variance,
+    recommend_gait,
+    recommend_map,
+)
 from suds_exp.plan.record import add_trial_to_version, record_trial
 from suds_exp.plan.target import GOALS, Target, TargetTruth
 from suds_exp.preprocess import get_version
@@ -215,8 +221,13 @@ class _State:
             achieved[self.best.name] = simulate_gaits([self.best], freq)[0].forward_mm
         self.best_achieved = float(achieved[self.best.name])
         self.map_error = truth.map_error(self.ensemble.point)
+        self.bias = None
         if opts.goal == "map":
-            self.curve = target_signal(self.samples, self.ensemble, target, opts.learner)
+            # the path jackknife is read twice (the signal, the plan): refitted once
+            self.bias = bias_variance(self.samples, target, opts.learner, self.ensemble.point)
+            self.curve = forecast_signal(
+                self.samples, self.ensemble, target, opts.cycles, opts.learner, self.bias
+            )
         else:
             self.curve = learning_curve(self.samples, opts.learner, seed)
         # the iteration's own verdict, before the loop's latch (`latched`) reads it
@@ -437,7 +448,12 @@ def _plan(state: _State, opts: LoopOptions, target: Target, trust: float, folder
         )
     else:
         rec = recommend_map(
-            state.ensemble, target, opts.cycles, samples=state.samples, learner=opts.learner
+            state.ensemble,
+            target,
+            opts.cycles,
+            samples=state.samples,
+            learner=opts.learner,
+            bias=state.bias,
         )[0]
     folder.mkdir(parents=True, exist_ok=True)
     if isinstance(rec.trial.gait, FourierGait) and rec.trial.file:

@@ -238,13 +238,15 @@ def recommend_map(
     n: int = 1,
     samples: pd.DataFrame | None = None,
     learner: str = GMR,
+    bias: np.ndarray | None = None,
 ) -> list[Recommendation]:
     """The ``n`` trials of ``cycles`` cycles that remove the most prediction variance
     over the target (see the module docstring): the noise term integrated over the
     target's paths plus the bias term, chosen greedily, in that order. ``samples``: the
     recorded data (the version's frame) whose cycles near each path sample discount a
     new trial's and whose paths give the bias term (refitted with ``learner``); None
-    counts none and adds no bias term."""
+    counts none and adds no bias term; ``bias``: `bias_variance` of ``samples`` when
+    the caller has it (computed here when None)."""
     pairs = target.pairs()
     n_path = 64
     variance = np.array([ensemble.displacement_spread([g], f)[0] for g, f in pairs])
@@ -256,7 +258,8 @@ def recommend_map(
     ]
     scale = candidate_spacing([g for g, _ in candidates], n_path)
     recorded = recorded_cycles_near(samples, target, n_path, scale)
-    bias = bias_variance(samples, target, learner, ensemble.point)
+    if bias is None:
+        bias = bias_variance(samples, target, learner, ensemble.point)
     covered = recorded_paths(samples)
     paths = [_path_features(g, n_path) for g, _ in pairs]
     brings, reach = [], []
