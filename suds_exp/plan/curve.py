@@ -24,9 +24,12 @@ enter (the target is the user's; nothing is simulated).
 map fitted on the first half of the recorded cycles and the map fitted on all of them
 predict the target's net displacement per cycle; if the last doubling moved those
 predictions by less than their bootstrap spread, the data of the second half did not
-teach the map anything about the target it could tell from noise. The loop says stop
-once this holds at two successive iterations and keeps saying it (`latched`), so one
-lucky refit neither fires it nor a later one unfires it.
+teach the map anything about the target it could tell from noise (kept for callers; it
+rarely fires, as each new path moves a refit by more than the bootstrap spread).
+
+`plan loop --goal map` says stop once the forecast holds at two successive iterations
+and keeps saying it (`latched`), so one lucky refit neither fires it nor a later one
+unfires it.
 """
 
 from __future__ import annotations
