@@ -34,17 +34,23 @@ def refused(*args: str) -> str:
     return r.stderr
 
 
+def _preprocessed(work: Path, gaits: str) -> Path:
+    """A database of ``gaits`` at 1/2 Hz, one trial of 10 cycles each, ingested and
+    preprocessed (version v1)."""
+    db = work / "plan.duckdb"
+    ok(
+        "simulate", "--out", str(work / "d"), "--gaits", gaits, "--freqs", "1/2",
+        "--repeats", "1", "--cycles", "10", "--ingest", "--db", str(db), "-q",
+    )  # fmt: skip
+    ok("preprocess", "--db", str(db), "-q")
+    return db
+
+
 @pytest.fixture(scope="module")
 def small(tmp_path_factory) -> Path:
     """O at 1/2 Hz, one trial of 10 cycles, ingested and preprocessed (version v1), and a
     second version (v2) whose shape has four actuated coordinates (cartesian r_a)."""
-    work = tmp_path_factory.mktemp("plan-small")
-    db = work / "small.duckdb"
-    ok(
-        "simulate", "--out", str(work / "d"), "--gaits", "O", "--freqs", "1/2",
-        "--repeats", "1", "--cycles", "10", "--ingest", "--db", str(db), "-q",
-    )  # fmt: skip
-    ok("preprocess", "--db", str(db), "-q")
+    db = _preprocessed(tmp_path_factory.mktemp("plan-small"), "O")
     ok("preprocess", "--name", "cart", "--param", "ra_repr=cartesian", "--db", str(db), "-q")
     return db
 
@@ -299,14 +305,7 @@ def test_run_after_a_map_loop_leaves_out_only_what_the_loop_recorded(tmp_path):
 @pytest.fixture(scope="module")
 def three_paths(tmp_path_factory) -> Path:
     """O, D- and S- at 1/2 Hz, one trial of 10 cycles each, preprocessed (version v1)."""
-    work = tmp_path_factory.mktemp("plan-three")
-    db = work / "three.duckdb"
-    ok(
-        "simulate", "--out", str(work / "d"), "--gaits", "O,D-,S-", "--freqs", "1/2",
-        "--repeats", "1", "--cycles", "10", "--ingest", "--db", str(db), "-q",
-    )  # fmt: skip
-    ok("preprocess", "--db", str(db), "-q")
-    return db
+    return _preprocessed(tmp_path_factory.mktemp("plan-three"), "O,D-,S-")
 
 
 def test_the_map_criterion_prefers_a_path_no_data_covers(three_paths):
