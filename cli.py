@@ -551,6 +551,8 @@ def preprocess(
         console.print_json(result.to_dict())
     else:
         console.out.print(preprocess_text(result))
+    for line in result.warnings:
+        console.err.print(f"warning: {line}")
 
 
 CampaignModelsOption = Annotated[

@@ -379,3 +379,14 @@ def test_the_map_stopping_signal_forecasts_the_next_doubling(small, three_paths)
     one, three = verdicts["one path"], verdicts["three paths"]
     assert not one.stop, one.message
     assert three.change_mm < one.change_mm
+
+
+def test_a_loop_from_an_empty_database_knows_the_robots_motor_axis_distance(gait_loop):
+    # a warm-up of one gait (O) leaves the fitted distance biased by about 3 mm
+    db, _ = gait_loop
+    row = Store(db).query_df(
+        "SELECT v.params, f.state FROM prep_versions v JOIN prep_fits f "
+        "ON f.version_id = v.id AND f.kind = 'joints'"
+    )
+    assert json.loads(row.params.iloc[0])["joint_distance_mm"] == 100.0
+    assert json.loads(row.state.iloc[0])["length_mm"] == 100.0

@@ -231,7 +231,7 @@ class SegmentModel(BodyModel):
     def interpolated_frames(self, measured: SegMeasured) -> int:
         return sum(measured.interpolated_frames.values())
 
-    def fit_joints(self, measured: Sequence[SegMeasured]) -> dict:
+    def fit_joints(self, measured: Sequence[SegMeasured], params=None) -> dict:
         """Each joint's centre as ``{joint: {segment: [x, y] mm in its frame}}``, and each
         ``from_joints`` segment's length (mm) and its RMS deviation over the frames."""
 

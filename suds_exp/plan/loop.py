@@ -345,7 +345,14 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
             seed = derive_seed("plan-record", name, 0) % 2**31
             trial_id = record_trial(store, warm, folder / "it0", seed, config)
             mark_trials_added(store, [trial_id], f"plan loop {name}")
-            run_preprocess(store, trials=[trial_id], progress=False)
+            # The simulator stands in for the robot, whose drawing gives the distance
+            # between its motor axes: one gait's warm-up cannot pin it down (O's shape
+            # loop is a circle), and the version keeps these segment origins for every
+            # trial the loop adds.
+            known = (config or SimConfig()).geometry.middle_length_mm
+            run_preprocess(
+                store, trials=[trial_id], params={"joint_distance_mm": known}, progress=False
+            )
             version = get_version(store)
             check_body(version)
         loop_id = _register(store, name, version.id, opts)

@@ -20,6 +20,7 @@ Following the paper's "Data Processing":
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -282,13 +283,17 @@ class Joints:
     """Segment origins (motor axes) in the head and tail top-marker frames.
 
     ``head`` and ``tail`` (2,) mm in their segment frames; ``length_mm`` their distance
-    (the middle segment's length); ``rms_mm`` the RMS of the distance's deviation.
+    (the middle segment's length, fitted or given); ``rms_mm`` the RMS of the distance's
+    deviation.
     """
 
     head: np.ndarray
     tail: np.ndarray
     length_mm: float
     rms_mm: float
+    #: how far (mm) the origins move when the trials' own marker noise is added once more
+    #: (`noise_shift`); NaN when not measured
+    noise_shift_mm: float = float("nan")
 
     def points(self, frames: SegmentFrames) -> tuple[np.ndarray, np.ndarray]:
         """Head and tail segment origins per frame, each (n_frames, 2) mm in the plane."""
@@ -298,8 +303,11 @@ class Joints:
         )
 
 
-def fit_joints(frames: SegmentFrames) -> Joints:
-    """Points fixed in the head and tail frames that keep a constant distance, mm."""
+def fit_joints(frames: SegmentFrames, length_mm: float | None = None) -> Joints:
+    """Points fixed in the head and tail frames that keep a constant distance, mm.
+
+    ``length_mm``: that distance when it is known (the robot's drawing), else fitted too.
+    """
     # Head frame expressed in the tail frame: relative offset p and angle psi.
     d = frames.head_origin - frames.tail_origin
     ta = frames.tail_angle
@@ -322,17 +330,81 @@ def fit_joints(frames: SegmentFrames) -> Joints:
     ps, cps, sps = p[::step], cp[::step], sp[::step]
 
     def residual(x):
-        ah, at, length = x[:2], x[2:4], x[4]
+        ah, at = x[:2], x[2:4]
+        length = x[4] if length_mm is None else length_mm
         jx = ps[:, 0] + cps * ah[0] - sps * ah[1] - at[0]
         jy = ps[:, 1] + sps * ah[0] + cps * ah[1] - at[1]
         return np.hypot(jx, jy) - length
 
-    fit = least_squares(residual, start, method="lm")
+    fit = least_squares(residual, start if length_mm is None else start[:4], method="lm")
     if not fit.success and fit.status <= 0:
         raise PreprocessError(f"segment origins: least squares did not converge ({fit.message})")
     ah, at = fit.x[:2], fit.x[2:4]
     dist = np.hypot(*(p + rotate(psi, ah[None]) - at).T)
-    return Joints(ah, at, float(np.mean(dist)), float(np.sqrt(np.mean((dist - dist.mean()) ** 2))))
+    length = float(np.mean(dist)) if length_mm is None else float(length_mm)
+    return Joints(ah, at, length, float(np.sqrt(np.mean((dist - length) ** 2))))
+
+
+#: Savitzky-Golay window (frames) and order whose residual estimates the frames' noise:
+#: short enough that a gait at 100 Hz is a local quadratic over it, so what is left is noise
+NOISE_WINDOW, NOISE_ORDER = 11, 2
+
+
+def noise_shift(
+    trials: Sequence[SegmentFrames], joints: Joints, length_mm: float | None, seed: int
+) -> float:
+    """How far the segment origins move (mm, the larger of the two) when noise like the
+    trials' own is added to the frames once more and the origins are fitted again.
+
+    Marker noise biases the constant-distance fit (its unknowns enter nonlinearly: errors
+    in variables), and doubling the noise about doubles the bias, so this shift
+    estimates the bias of ``joints`` itself (the first step of SIMEX, Cook & Stefanski
+    1994). It is large when the trials leave the fit nearly free along one direction,
+    e.g. a single gait whose shape loop is a circle. The noise of each channel (both
+    origins' x, y and both angles) is the RMS of its residual from a local quadratic,
+    per trial. Averaged over two draws of ``seed``'s generator.
+    """
+    from scipy.signal import savgol_coeffs, savgol_filter
+
+    # the residual of a least-squares smoother keeps 1 - h_00 of white noise's variance
+    keep = np.sqrt(1.0 - savgol_coeffs(NOISE_WINDOW, NOISE_ORDER)[NOISE_WINDOW // 2])
+    channels = []
+    for tr in trials:
+        if len(tr.head_angle) <= NOISE_WINDOW:
+            continue
+        arrays = (
+            tr.head_origin,
+            np.unwrap(tr.head_angle),
+            tr.tail_origin,
+            np.unwrap(tr.tail_angle),
+        )
+        channels.append(arrays)
+    if not channels:
+        return float("nan")
+    sigma = [
+        np.sqrt(
+            np.mean(
+                np.concatenate(
+                    [
+                        (a[k] - savgol_filter(a[k], NOISE_WINDOW, NOISE_ORDER, axis=0)) ** 2
+                        for a in channels
+                    ]
+                ),
+                axis=0,
+            )
+        )
+        / keep
+        for k in range(4)
+    ]
+    pooled = [np.concatenate([a[k] for a in channels]) for k in range(4)]
+    rng = np.random.default_rng(seed)
+    shifted = []
+    for _ in range(2):
+        noisy = [x + rng.normal(size=x.shape) * sd for x, sd in zip(pooled, sigma, strict=True)]
+        again = fit_joints(SegmentFrames(*noisy), length_mm)
+        shifted.append(np.concatenate([again.head, again.tail]))
+    moved = np.mean(shifted, axis=0) - np.concatenate([joints.head, joints.tail])
+    return float(max(np.hypot(*moved[:2]), np.hypot(*moved[2:])))
 
 
 @dataclass(frozen=True)

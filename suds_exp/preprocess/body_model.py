@@ -12,17 +12,26 @@ does exactly that; `SwimmerModel` is the paper's swimmer (the pipeline's default
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from suds_exp.errors import PreprocessError
 from suds_exp.ingest.layout import trial_layout
-from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints
+from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints, noise_shift
 from suds_exp.preprocess.chain import chain_settings
 from suds_exp.preprocess.kinematics import Kinematics, kinematics, measure
+from suds_exp.preprocess.params import params_hash
 from suds_exp.robot import ROLES
+
+#: `SwimmerModel.joints_warning` speaks when `noise_shift` moves a motor axis further than
+#: this, mm. On the simulated robot (two dataset seeds) each gait alone but O, and O with
+#: another gait, stay at or under 0.33 mm (joint angles within 0.004 rad of the truth);
+#: O alone moves them 0.84-1.22 mm (0.014-0.017 rad). docs/results/preprocessing.md.
+JOINT_SHIFT_WARN_MM = 0.5
 
 
 class BodyModel:
@@ -59,9 +68,15 @@ class BodyModel:
         points; 0 for a model that does not tell."""
         return 0
 
-    def fit_joints(self, measured: Sequence[Any]) -> Any:
-        """What the version shares, fitted on the measured trials (the joint positions)."""
+    def fit_joints(self, measured: Sequence[Any], params: Mapping[str, Any] | None = None) -> Any:
+        """What the version shares, fitted on the measured trials (the joint positions);
+        ``params``: the version's parameters."""
         raise NotImplementedError
+
+    def joints_warning(self, joints: Any) -> str | None:
+        """One line when ``joints`` are poorly determined by the trials they were fitted
+        on (None when they are not, or the model cannot tell)."""
+        return None
 
     def joints_state(self, joints: Any) -> str:
         raise NotImplementedError
@@ -106,14 +121,35 @@ class SwimmerModel(BodyModel):
     def measure(self, xyz: np.ndarray, params: dict[str, Any], filled=None):
         return measure(xyz, params["tail_fit"])
 
-    def fit_joints(self, measured: Sequence[Any]) -> Joints:
-        return fit_joints(
-            SegmentFrames(
-                *[
-                    np.concatenate([getattr(m.frames, a) for m in measured])
-                    for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
-                ]
-            )
+    def fit_joints(
+        self, measured: Sequence[Any], params: Mapping[str, Any] | None = None
+    ) -> Joints:
+        """The motor axes over the trials, at ``joint_distance_mm`` apart when it is given
+        (> 0), with their `noise_shift` when ``params`` are given (seeded by their hash)."""
+        frames = [m.frames for m in measured]
+        pooled = SegmentFrames(
+            *[
+                np.concatenate([getattr(f, a) for f in frames])
+                for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
+            ]
+        )
+        known = (params or {}).get("joint_distance_mm") or None
+        joints = fit_joints(pooled, known)
+        if params is None:
+            return joints
+        seed = int(params_hash(params)[:8], 16)
+        return replace(joints, noise_shift_mm=noise_shift(frames, joints, known, seed))
+
+    def joints_warning(self, joints: Joints) -> str | None:
+        if not joints.noise_shift_mm > JOINT_SHIFT_WARN_MM:
+            return None
+        return (
+            f"segment origins are poorly determined by these trials: noise like their own "
+            f"moves the motor axes by {joints.noise_shift_mm:.1f} mm (fitted "
+            f"{joints.length_mm:.1f} mm apart), so joint angles and body velocity may be "
+            "biased by a few per cent; give the distance between the motor axes as "
+            "--param joint_distance_mm=MM, or preprocess together with trials of a gait "
+            "whose shape loop is not a circle"
         )
 
     def joints_state(self, joints: Joints) -> str:
@@ -123,12 +159,22 @@ class SwimmerModel(BodyModel):
                 "tail": joints.tail.tolist(),
                 "length_mm": joints.length_mm,
                 "rms_mm": joints.rms_mm,
+                "noise_shift_mm": None
+                if math.isnan(joints.noise_shift_mm)
+                else joints.noise_shift_mm,
             }
         )
 
     def joints_from(self, state: str) -> Joints:
         d = json.loads(state)
-        return Joints(np.asarray(d["head"]), np.asarray(d["tail"]), d["length_mm"], d["rms_mm"])
+        shift = d.get("noise_shift_mm")
+        return Joints(
+            np.asarray(d["head"]),
+            np.asarray(d["tail"]),
+            d["length_mm"],
+            d["rms_mm"],
+            float("nan") if shift is None else shift,
+        )
 
     def kinematics(self, measured, joints, params, rate_hz, frequency_hz) -> Kinematics:
         chain = chain_settings(params, rate_hz, frequency_hz, len(measured.local))

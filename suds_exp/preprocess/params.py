@@ -22,6 +22,9 @@ DEFAULTS: dict[str, Any] = {
     "max_gap_s": 0.25,  # refuse a trial whose longest gap to fill exceeds this, s
     # body frame
     "joint_fit": "version",  # segment origins fitted over all trials of the version | per trial
+    # the distance between the two motor axes when it is known (the robot's drawing), mm;
+    # 0 = fit it. A single gait whose shape loop is a circle leaves it poorly determined
+    "joint_distance_mm": 0.0,
     # tail frame: rigid = per-frame least-squares fit of tail_top_1, tail_top_2, tail_back
     # (less noise in the body pose and velocity); rigid+flippers = that, plus the tail
     # flipper markers staying on their circles about the hinges | top = its two top markers
@@ -117,7 +120,13 @@ def _check(params: dict[str, Any]) -> None:
     for key in positive:
         if not params[key] > 0:
             raise ConfigError(f"params {key}={params[key]}: must be > 0", param="params")
-    for key in ("phaser_pad_cycles", "shape_window_s", "sg_window_cycles", "chain_window_cycles"):
+    for key in (
+        "phaser_pad_cycles",
+        "shape_window_s",
+        "sg_window_cycles",
+        "chain_window_cycles",
+        "joint_distance_mm",
+    ):
         if params[key] < 0:
             raise ConfigError(f"params {key}={params[key]}: must be >= 0", param="params")
     if not 0 <= params["sg_window_exponent"] <= 2:

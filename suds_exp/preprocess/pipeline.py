@@ -59,7 +59,9 @@ class PrepResult:
     ``explained_variance_ratio``: of the k kept passive components (fraction each);
     ``interpolated_pose_frames``: frames of a segment, summed over segments and the
     trials processed now, whose pose came from interpolated tracks because too few of
-    its markers were seen (a segment body's; the swimmer's pipeline reports none).
+    its markers were seen (a segment body's; the swimmer's pipeline reports none);
+    ``warnings``: one line per fit of this run the trials did not pin down (e.g. the
+    segment origins), for the command layer to show.
     """
 
     version_id: int
@@ -73,6 +75,7 @@ class PrepResult:
     n_samples: int = 0
     interpolated_pose_frames: int = 0
     seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -272,12 +275,14 @@ def _stats_row(tr: _Trial, version_id: int, joints: Any, model: BodyModel) -> di
 @dataclass
 class Fitted:
     """What a version holds for its trials: segment origins by trial id, the passive PCA,
-    one Phaser per trial group, and the fits this run made (`NewFit`, not yet stored)."""
+    one Phaser per trial group, the fits this run made (`NewFit`, not yet stored) and
+    one line per thing those fits could not pin down."""
 
     joints: dict[int, Any]
     pca: PassivePCA
     phasers: dict[str, Phaser]
     new: list[NewFit] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
 
 def preprocess(
@@ -346,6 +351,7 @@ def _preprocess(store, name, params, trials, progress, started, model) -> PrepRe
     write_version(store, result, fitted.new, fitted.pca, params["k"])
     write_samples(store, result, items, fitted, params, progress, model)
     result.explained_variance_ratio = fitted.pca.explained_variance_ratio_[: params["k"]].tolist()
+    result.warnings = fitted.warnings
     result.seconds = time.perf_counter() - started
     return result
 
@@ -392,15 +398,22 @@ def fit(
     trials of this run, and set each trial's kinematics."""
     model = SwimmerModel() if model is None else model
     new: list[NewFit] = []
+    warnings: list[str] = []
     if params["joint_fit"] == "version":
         if ("joints", "") in fits:
             shared = model.joints_from(fits[("joints", "")])
         else:
-            shared = model.fit_joints([tr.measured for tr in items])
+            shared = model.fit_joints([tr.measured for tr in items], params)
             new.append(_new_fit("joints", "", model.joints_state(shared), items))
+            warnings += [w for w in [model.joints_warning(shared)] if w]
         joints = {tr.id: shared for tr in items}
     else:
-        joints = {tr.id: model.fit_joints([tr.measured]) for tr in items}
+        joints = {tr.id: model.fit_joints([tr.measured], params) for tr in items}
+        poor = [tid for tid, j in joints.items() if model.joints_warning(j)]
+        if poor:
+            warnings.append(
+                f"trials {', '.join(map(str, poor))}: {model.joints_warning(joints[poor[0]])}"
+            )
     for tr in items:
         tr.kin = model.kinematics(tr.measured, joints[tr.id], params, tr.rate_hz, tr.frequency_hz)
     # the passive reducer (PCA, kernel PCA or autoencoder: suds_exp.preprocess.reduction)
@@ -422,7 +435,7 @@ def fit(
         except PreprocessError as exc:
             raise PreprocessError(f"phase of trial group {group}: {exc}") from None
         new.append(_new_fit("phaser", group, json.dumps(phasers[group].to_dict()), members))
-    return Fitted(joints, pca, phasers, new)
+    return Fitted(joints, pca, phasers, new, warnings)
 
 
 def write_samples(
