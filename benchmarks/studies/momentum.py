@@ -5,6 +5,8 @@ Usage (from the repository root)::
 
     OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/momentum
         [--taus 0,0.1,0.25,0.5] [--ratios 1,1.5,2.5] [--boots 6] [--train-cycles 4]
+    OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/x --why-tau 0.3
+        [--prep-param joint_distance_mm=100]
     OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/x --synthetic
     OMP_NUM_THREADS=1 .venv/bin/python -m benchmarks.studies.momentum --out /tmp/x \
         --snake ../shared/refdata
@@ -47,13 +49,17 @@ def cli(*args: str) -> None:
     subprocess.run([sys.executable, "-m", "suds_exp", *args, "-q"], check=True, env=os.environ)
 
 
+#: ``--prep-param`` values, passed to every `preprocess` as ``--param``
+PREP_PARAMS: list[str] = []
+
+
 def dataset(out: Path, effect: str) -> Path:
     name = effect.replace("=", "-").replace(".", "_")
     folder, db = out / name, out / f"{name}.duckdb"
     if not db.exists():
         cli("simulate", "--out", str(folder), "--gaits", "O", "--repeats", "2", "--cycles",
             "12:16", "--effect", effect, "--ingest", "--db", str(db))  # fmt: skip
-        cli("preprocess", "--db", str(db))
+        cli("preprocess", "--db", str(db), *[a for v in PREP_PARAMS for a in ("--param", v)])
     return db
 
 
@@ -265,7 +271,10 @@ def main(argv=None) -> None:
     ap.add_argument("--snake", type=Path, help="refdata folder: the flying snake, GMR vs GMR+P")
     ap.add_argument("--why-tau", metavar="TAU", help="GMR+P's time constants against the truth")
     ap.add_argument("--quick", action="store_true", help="a smoke run: tau 0, one draw")
+    ap.add_argument("--prep-param", action="append", default=[], metavar="KEY=VALUE",
+                    help="a preprocessing parameter for every dataset (repeatable)")  # fmt: skip
     args = ap.parse_args(argv)
+    PREP_PARAMS[:] = args.prep_param
     if args.quick:
         with tempfile.TemporaryDirectory(prefix="suds-momentum-quick-") as tmp:
             args.out, args.taus, args.ratios, args.boots = Path(tmp), "0", "", 1
