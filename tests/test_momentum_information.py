@@ -45,7 +45,11 @@ def test_helps_with_a_lag_and_does_not_without():
     overall = lag.iloc[-1]
     assert overall["verdict"] == "helps" and overall["ratio_high"] < 1
     assert overall["tau_vx_s"] == pytest.approx(0.3, rel=0.2)
+    # the one time constant that best predicts each held-out speed
+    assert set(lag["tau_s"]) == {overall["tau_s"]}
+    assert overall["tau_s"] == pytest.approx(0.3, rel=0.2)
     assert none.iloc[-1]["verdict"] == "does not help"
+    assert none.iloc[-1]["tau_s"] < 0.05
     assert none.iloc[-1]["ratio_low"] >= 0.95
 
 
