@@ -86,3 +86,51 @@ def test_a_distance_that_is_not_positive_is_refused_and_nothing_is_written(one_l
     with pytest.raises(ConfigError, match="joint_distance_mm"):
         preprocess(one_loop, params={"joint_distance_mm": value}, progress=False)
     assert one_loop.query_df("SELECT count(*) AS n FROM prep_versions").n.iloc[0] == before
+
+
+def _swimmer_description(folder: Path, length: str = "") -> Path:
+    """The built-in swimmer description, its middle segment's length given or not."""
+    from importlib import resources
+
+    text = resources.files("suds_exp.body").joinpath("swimmer.toml").read_text()
+    text = text.replace("from_joints = true\n", f"from_joints = true\n{length}", 1)
+    path = folder / "swimmer.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_body_description_warns_too_and_takes_the_middle_segments_length(one_loop, tmp_path):
+    from suds_exp.body import SegmentModel, load_body, preprocess_body
+
+    # the generic segment model (the swimmer's description through it)
+    generic = {"tail_fit": "rigid", "body_fit": "segments"}
+    fitted = preprocess(
+        one_loop,
+        name="generic",
+        params=generic,
+        body=SegmentModel(load_body(_swimmer_description(tmp_path))),
+        progress=False,
+    )
+    (warning,) = fitted.warnings
+    assert "segments.middle" in warning and "length_mm" in warning
+    known = load_body(_swimmer_description(tmp_path, f"length_mm = {MIDDLE_MM}\n"))
+    given = preprocess(
+        one_loop, name="generic-known", params=generic, body=SegmentModel(known), progress=False
+    )
+    assert given.warnings == []
+    errors = truth_errors(one_loop, given.version_id).set_index("trial_id").loc[-1]
+    assert errors.err_ra < 0.005
+    # the swimmer's description goes to the standard pipeline, with the length as its
+    # joint_distance_mm
+    standard = preprocess_body(one_loop, known, name="body-known", progress=False)
+    assert standard.params["joint_distance_mm"] == MIDDLE_MM
+    assert standard.warnings == []
+
+
+@pytest.mark.parametrize("line", ["length_mm = -3\n", "length_mm = 'long'\n", "length_mm = true\n"])
+def test_a_bad_segment_length_is_one_line(tmp_path, line):
+    from suds_exp.body import load_body
+    from suds_exp.body.description import BodyError
+
+    with pytest.raises(BodyError, match=r"segments\.middle\.length_mm"):
+        load_body(_swimmer_description(tmp_path, line))

@@ -4,7 +4,8 @@ Two kinds of body:
 
 - **segments**: rigid segments, each with its markers and their roles (at least 2
   markers, or none with ``from_joints = true`` when the segment is located by its joints,
-  as the swimmer's middle segment is), joints between segments (``actuated`` or
+  as the swimmer's middle segment is; then ``length_mm``, the distance between its two
+  joints, can be given when it is known, or it is fitted), joints between segments (``actuated`` or
   ``passive``; they must form one tree that connects every segment, in which each
   segment is the child of at most one joint), and passive markers hanging from a
   segment. ``frame`` lists the markers fixed
@@ -67,6 +68,9 @@ class Segment:
     from_joints: bool = False
     #: the markers that give the segment's pose, in order (empty: all its markers)
     frame: list[str] = field(default_factory=list)
+    #: from_joints only: the distance between its two joints when it is known (the
+    #: robot's drawing), mm; None = fitted from the trials
+    length_mm: float | None = None
 
     @property
     def frame_markers(self) -> list[str]:
@@ -126,6 +130,10 @@ class Body:
         """Everything that defines the body (not its file), for a version's parameters."""
         d = asdict(self)
         d.pop("source")
+        for seg in d.get("segments", []):
+            # unset, it is left out: descriptions without it keep their versions
+            if seg.get("length_mm") is None:
+                seg.pop("length_mm", None)
         return d
 
     def digest(self) -> str:
@@ -221,7 +229,7 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
     for seg_name, raw in _table(src, doc["segments"], "segments").items():
         where = f"segments.{seg_name}"
         raw = _table(src, raw, where)
-        _known_keys(src, raw, ("markers", "from_joints", "frame"), where)
+        _known_keys(src, raw, ("markers", "from_joints", "frame", "length_mm"), where)
         markers = _table(src, raw.get("markers", {}), f"{where}.markers")
         frame = raw.get("frame", [])
         if not isinstance(frame, list) or any(m not in markers for m in frame):
@@ -241,6 +249,17 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
                 f"{src}: {where}: {len(markers)} marker(s); a rigid segment needs at least 2 "
                 "to give its orientation (or from_joints = true)"
             )
+        length = raw.get("length_mm")
+        if length is not None and (
+            not from_joints
+            or isinstance(length, bool)
+            or not isinstance(length, int | float)
+            or not length > 0
+        ):
+            raise BodyError(
+                f"{src}: {where}.length_mm: expected a distance > 0 (mm) between the joints "
+                "of a from_joints segment"
+            )
         for marker, role in markers.items():
             if not isinstance(role, str):
                 raise BodyError(f"{src}: {where}.markers.{marker}: expected its role as text")
@@ -249,7 +268,15 @@ def _parse_segments(src: str, name: str, doc: dict) -> Body:
                     f"{src}: {where}.markers.{marker}: already on segment {owner[marker]!r}"
                 )
             owner[marker] = seg_name
-        segments.append(Segment(seg_name, dict(markers), from_joints, list(frame)))
+        segments.append(
+            Segment(
+                seg_name,
+                dict(markers),
+                from_joints,
+                list(frame),
+                None if length is None else float(length),
+            )
+        )
     names = [s.name for s in segments]
     joints = []
     raw_joints = doc.get("joints", [])

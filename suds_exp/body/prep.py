@@ -74,7 +74,9 @@ def preprocess_body(
     `PreprocessError` as the standard pipeline does.
     """
     if body.is_swimmer():
-        return preprocess(store, name, params, trials, progress, preset=preset)
+        return preprocess(
+            store, name, _swimmer_params(body, params), trials, progress, preset=preset
+        )
     if preset is not None:
         raise BodyError(
             f"{body.source}: preset {preset!r} describes the swimmer; this body takes params only"
@@ -85,6 +87,21 @@ def preprocess_body(
         given = {"k": min(DEFAULTS["k"], model.n_passive), **SWIMMER_ONLY, **dict(params or {})}
         return preprocess(store, name, given, trials, progress, body=model)
     return _preprocess_chain(store, body, name, params, trials, progress)
+
+
+def _swimmer_params(body: Body, params: Mapping[str, Any] | None) -> dict[str, Any]:
+    """``params`` with the middle segment's ``length_mm`` as ``joint_distance_mm``: the
+    standard pipeline reads the distance between the motor axes from its parameters."""
+    given = dict(params or {})
+    length = next(s.length_mm for s in body.segments if s.name == body.body_frame)
+    if length is None:
+        return given
+    if float(given.get("joint_distance_mm") or length) != length:
+        raise BodyError(
+            f"{body.source}: segments.{body.body_frame}.length_mm = {length:g} but "
+            f"joint_distance_mm = {given['joint_distance_mm']}; give one of them"
+        )
+    return {**given, "joint_distance_mm": length}
 
 
 def _chain_tracks(conn: sa.Connection, body: Body, meta_row) -> tuple[np.ndarray, ...]:

@@ -61,12 +61,14 @@ from suds_exp.preprocess.body_frame import (
     SegmentFrames,
     fit_joints,
     fit_plane,
+    noise_shift,
     procrustes,
     rotate,
     to_frame,
 )
-from suds_exp.preprocess.body_model import BodyModel
+from suds_exp.preprocess.body_model import JOINT_SHIFT_WARN_MM, BodyModel
 from suds_exp.preprocess.kinematics import Kinematics
+from suds_exp.preprocess.params import params_hash
 from suds_exp.robot import MAX_K
 
 #: Most actuated joints a version's samples hold (columns ra_1 .. ra_8, migration 018).
@@ -232,29 +234,61 @@ class SegmentModel(BodyModel):
         return sum(measured.interpolated_frames.values())
 
     def fit_joints(self, measured: Sequence[SegMeasured], params=None) -> dict:
-        """Each joint's centre as ``{joint: {segment: [x, y] mm in its frame}}``, and each
-        ``from_joints`` segment's length (mm) and its RMS deviation over the frames."""
+        """Each joint's centre as ``{joint: {segment: [x, y] mm in its frame}}``, each
+        ``from_joints`` segment's length (mm, its ``length_mm`` when the description gives
+        it) and its RMS deviation over the frames, and, given the version's ``params``,
+        how far noise like the trials' own moves its joints (`noise_shift`, mm)."""
 
         def pooled(seg):
             return tuple(np.concatenate([m.frames[seg][i] for m in measured]) for i in (0, 1))
 
         centres: dict[str, dict[str, list[float]]] = {j.name: {} for j in self.body.joints}
         links: dict[str, list[float]] = {}
+        shifts: dict[str, float] = {}
         for seg in self.body.segments:
             if not seg.from_joints:
                 continue
             down, up = self.parent_joint[seg.name], self.child_joints[seg.name][0]
             (to, ta), (ho, ha) = pooled(down.parent), pooled(up.child)
-            fitted = fit_joints(SegmentFrames(ho, ha, to, ta))
+            fitted = fit_joints(SegmentFrames(ho, ha, to, ta), seg.length_mm)
             centres[up.name][up.child] = fitted.head.tolist()
             centres[down.name][down.parent] = fitted.tail.tolist()
             links[seg.name] = [fitted.length_mm, fitted.rms_mm]
+            if params is not None:
+                trials = [
+                    SegmentFrames(*m.frames[up.child], *m.frames[down.parent]) for m in measured
+                ]
+                seed = int(params_hash(params)[:8], 16)
+                shifts[seg.name] = noise_shift(trials, fitted, seg.length_mm, seed)
         for j in self.body.joints:
             if self.segments[j.parent].from_joints or self.segments[j.child].from_joints:
                 continue
             a, b = _common_point(*pooled(j.parent), *pooled(j.child))
             centres[j.name] = {j.parent: a.tolist(), j.child: b.tolist()}
-        return {"centres": centres, "links": links}
+        out = {"centres": centres, "links": links}
+        if shifts:
+            out["noise_shift_mm"] = shifts
+        return out
+
+    def joints_warning(self, joints: dict) -> str | None:
+        poor = {
+            seg: shift
+            for seg, shift in joints.get("noise_shift_mm", {}).items()
+            if shift > JOINT_SHIFT_WARN_MM
+        }
+        if not poor:
+            return None
+        named = ", ".join(
+            f"segments.{seg} (joints moved {shift:.1f} mm, fitted "
+            f"{joints['links'][seg][0]:.1f} mm apart)"
+            for seg, shift in poor.items()
+        )
+        return (
+            f"joints of {named} are poorly determined by these trials: noise like their own "
+            "moves them, so joint angles and body velocity may be biased by a few per cent; "
+            "give the segment's length_mm in the body description, or preprocess together "
+            "with trials of a gait whose shape loop is not a circle"
+        )
 
     def joints_state(self, joints: dict) -> str:
         return json.dumps(joints)
