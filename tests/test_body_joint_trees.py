@@ -22,13 +22,13 @@ from suds_exp.ingest.readers import read_capture
 from suds_exp.preprocess import load_samples
 from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.store import Store
+from suds_exp.testing.database import assert_same_db, dump_db
 from suds_exp.testing.kinematic_body import (
     random_tree_body,
     serial_body,
     sine,
     write_body_trial,
 )
-from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 

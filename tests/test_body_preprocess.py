@@ -15,8 +15,8 @@ from cli import app
 from suds_exp.ingest import ingest_paths
 from suds_exp.preprocess import load_samples
 from suds_exp.store import Store
+from suds_exp.testing.database import assert_same_db, dump_db
 from suds_exp.testing.synthetic_captures import write_dataset
-from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 

@@ -18,9 +18,9 @@ from suds_exp.ingest.readers import read_capture
 from suds_exp.preprocess import load_samples, preprocess
 from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.store import Store
+from suds_exp.testing.database import assert_same_db, dump_db
 from suds_exp.testing.kinematic_body import serial_body, write_body_trial
 from suds_exp.testing.synthetic_captures import write_dataset
-from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 

@@ -19,7 +19,6 @@ from typer.testing import CliRunner
 
 import cli
 from suds_exp.store import Store
-from tests.helpers import campaign_rows
 
 pytestmark = pytest.mark.slow
 
@@ -99,7 +98,7 @@ def version_db(tmp_path_factory) -> Path:
     return db
 
 
-def test_a_killed_worker_and_a_killed_scheduler_lose_nothing(tmp_path, version_db):
+def test_a_killed_worker_and_a_killed_scheduler_lose_nothing(tmp_path, version_db, campaign_rows):
     local = tmp_path / "local.duckdb"
     shutil.copy(version_db, local)
     out = CliRunner().invoke(cli.app, [*RUN, "--db", str(local)])

@@ -8,7 +8,7 @@ import pytest
 from suds_exp.campaign import CampaignError, Draw, SampleBank, enumerate_draws, parse_int_list
 from suds_exp.campaign.conditions import select_conditions
 from suds_exp.campaign.sampling import draw_sample
-from tests.helpers import synthetic_samples
+from suds_exp.testing.synthetic_samples import synthetic_samples
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.models import TLS, make_model
 from suds_exp.robot import VB_COLUMNS
 from suds_exp.store import Store
-from tests.helpers import campaign_rows, synthetic_samples
+from suds_exp.testing.synthetic_samples import synthetic_samples
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +93,9 @@ def test_a_learner_is_checked_once_then_built_like_make_model():
         make_model("TLS", ridge=1e-6, nonsense=1)
 
 
-def test_a_run_stopped_inside_a_chunk_resumes_with_every_row_once(tmp_path, monkeypatch):
+def test_a_run_stopped_inside_a_chunk_resumes_with_every_row_once(
+    tmp_path, monkeypatch, campaign_rows
+):
     samples = synthetic_samples(conditions=(("O", 0.5), ("D+", 1.0)))
     options = CampaignOptions(models=["phase-only", "TLS"], boots=2, train_cycles=3, sweep=[1])
     full = Store(tmp_path / "full.duckdb")

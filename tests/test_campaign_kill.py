@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 import cli
 from suds_exp.campaign import KEY_COLUMNS, CampaignOptions, run_campaign
 from suds_exp.store import Store
-from tests.helpers import campaign_rows, start_campaign, synthetic_samples, wait_batches
+from suds_exp.testing.synthetic_samples import synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS"], boots=4, train_cycles=3, sweep=[1, 2])
 
@@ -27,7 +27,9 @@ def samples_file(tmp_path_factory) -> Path:
     return path
 
 
-def kill_and_resume(tmp_path, samples_file, n_kills: int) -> None:
+def kill_and_resume(
+    tmp_path, samples_file, n_kills: int, campaign_rows, start_campaign, wait_batches
+) -> None:
     samples = pd.read_parquet(samples_file)
     reference = Store(tmp_path / "reference.duckdb")
     run_campaign(reference, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
@@ -52,12 +54,14 @@ def kill_and_resume(tmp_path, samples_file, n_kills: int) -> None:
     pd.testing.assert_frame_equal(campaign_rows(Store(db)), expected, check_exact=True)
 
 
-def test_sigkill_at_five_random_moments_loses_nothing_it_wrote(tmp_path, samples_file):
-    kill_and_resume(tmp_path, samples_file, n_kills=5)
+def test_sigkill_at_five_random_moments_loses_nothing_it_wrote(
+    tmp_path, samples_file, campaign_rows, start_campaign, wait_batches
+):
+    kill_and_resume(tmp_path, samples_file, 5, campaign_rows, start_campaign, wait_batches)
 
 
 def test_status_and_sql_answer_and_a_second_run_is_refused_while_a_campaign_runs(
-    tmp_path, samples_file
+    tmp_path, samples_file, start_campaign, wait_batches
 ):
     db = tmp_path / "busy.duckdb"
     options = dict(OPTIONS, boots=20)

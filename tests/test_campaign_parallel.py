@@ -7,7 +7,7 @@ import pytest
 
 from suds_exp.campaign import CampaignOptions, run_campaign
 from suds_exp.store import Store
-from tests.helpers import campaign_rows, synthetic_samples
+from suds_exp.testing.synthetic_samples import synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS+SUDS"], boots=2, train_cycles=3, sweep=[1])
 N_JOBS = (9 * 2 + 3 * 2) * 2
@@ -19,7 +19,7 @@ def samples() -> pd.DataFrame:
 
 
 @pytest.fixture(scope="module")
-def reference(tmp_path_factory, samples) -> pd.DataFrame:
+def reference(tmp_path_factory, samples, campaign_rows) -> pd.DataFrame:
     one = Store(tmp_path_factory.mktemp("one") / "one.duckdb")
     run_campaign(one, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     frame = campaign_rows(one)
@@ -27,7 +27,7 @@ def reference(tmp_path_factory, samples) -> pd.DataFrame:
     return frame
 
 
-def run_on(tmp_path, samples, **kw) -> pd.DataFrame:
+def run_on(tmp_path, samples, campaign_rows, **kw) -> pd.DataFrame:
     store = Store(tmp_path / "x.duckdb")
     summary = run_campaign(
         store, "c", CampaignOptions(**OPTIONS), samples=samples, chunk_jobs=3, progress=False, **kw
@@ -36,19 +36,24 @@ def run_on(tmp_path, samples, **kw) -> pd.DataFrame:
     return campaign_rows(store)
 
 
-def test_two_loky_workers_give_the_rows_of_one(tmp_path, samples, reference):
-    rows = run_on(tmp_path, samples, jobs=2)
+def test_two_loky_workers_give_the_rows_of_one(tmp_path, samples, reference, campaign_rows):
+    rows = run_on(tmp_path, samples, campaign_rows, jobs=2)
     pd.testing.assert_frame_equal(rows, reference, check_exact=True)
 
 
 def test_a_two_process_dask_local_cluster_gives_the_rows_of_one_worker(
-    tmp_path, samples, reference
+    tmp_path, samples, reference, campaign_rows
 ):
     distributed = pytest.importorskip("dask.distributed")
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster:
         rows = run_on(
-            tmp_path, samples, jobs=2, backend="dask", scheduler=cluster.scheduler_address
+            tmp_path,
+            samples,
+            campaign_rows,
+            jobs=2,
+            backend="dask",
+            scheduler=cluster.scheduler_address,
         )
     pd.testing.assert_frame_equal(rows, reference, check_exact=True)

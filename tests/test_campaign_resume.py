@@ -12,7 +12,7 @@ from suds_exp.campaign import CampaignOptions, enumerate_draws, run_campaign
 from suds_exp.campaign.bank import rounded_conditions
 from suds_exp.campaign.job import RESULT_COLUMNS
 from suds_exp.store import Store
-from tests.helpers import synthetic_samples
+from suds_exp.testing.synthetic_samples import synthetic_samples
 
 MODELS = ["phase-only", "TLS"]
 

@@ -22,8 +22,8 @@ from suds_exp.campaign.lock import RunLock
 from suds_exp.errors import StoreError
 from suds_exp.models.registry import LEARNERS
 from suds_exp.store import Store
+from suds_exp.testing.synthetic_samples import synthetic_samples
 from suds_exp.workflows.demo_campaign import demo_campaign, demo_options
-from tests.helpers import campaign_rows, synthetic_samples
 
 OPTIONS = dict(models=["phase-only", "TLS"], boots=2, train_cycles=4, sweep=[1, 2])
 
@@ -33,7 +33,7 @@ def samples() -> pd.DataFrame:
     return synthetic_samples()
 
 
-def test_a_campaign_fills_one_row_per_job(db, samples):
+def test_a_campaign_fills_one_row_per_job(db, samples, campaign_rows):
     store = Store(db)
     summary = run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     # 4 conditions: 16 pairs x 2 boots + 4 same-condition pairs x 2 boots x 2 sweep values
@@ -66,7 +66,7 @@ def test_a_campaign_fills_one_row_per_job(db, samples):
     assert [m["done"] for m in status["models"]] == [summary.total_jobs // 2] * 2
 
 
-def test_resume_skips_finished_jobs_and_reproduces_the_rest(db, tmp_path, samples):
+def test_resume_skips_finished_jobs_and_reproduces_the_rest(db, tmp_path, samples, campaign_rows):
     store = Store(db)
     full = Store(tmp_path / "full.duckdb")
     run_campaign(full, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
@@ -82,7 +82,9 @@ def test_resume_skips_finished_jobs_and_reproduces_the_rest(db, tmp_path, sample
     assert nothing.done_now == 0 and "already done" in nothing.message()
 
 
-def test_continuing_with_changed_options_is_refused_naming_the_differences(db, samples):
+def test_continuing_with_changed_options_is_refused_naming_the_differences(
+    db, samples, campaign_rows
+):
     store = Store(db)
     run_campaign(store, "c", CampaignOptions(**OPTIONS), samples=samples, progress=False)
     before = campaign_rows(store)

@@ -13,7 +13,8 @@ import cli
 from suds_exp.campaign import CampaignError, CampaignOptions, SampleBank, run_campaign
 from suds_exp.campaign.status import campaign_status
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, dump_db, synthetic_samples
+from suds_exp.testing.database import assert_same_db, dump_db
+from suds_exp.testing.synthetic_samples import synthetic_samples
 
 SHORT = ("D+", 0.5)
 

@@ -20,18 +20,17 @@ from typer.testing import CliRunner
 from cli import app
 from suds_exp.discrepancy.effects import effect_names
 from suds_exp.store import Store
-from tests.helpers import discrepancy_json, inertia_store
 
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def inertia_db(tmp_path_factory) -> Path:
+def inertia_db(tmp_path_factory, inertia_store) -> Path:
     return inertia_store(tmp_path_factory.mktemp("withheld"), tau_s=0.3, seed=5)
 
 
 @pytest.fixture(scope="module")
-def unexplained_run(inertia_db, tmp_path_factory):
+def unexplained_run(inertia_db, tmp_path_factory, discrepancy_json):
     out = tmp_path_factory.mktemp("report") / "disc"
     excluded = ",".join(effect_names())
     return discrepancy_json(

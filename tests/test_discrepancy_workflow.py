@@ -26,20 +26,19 @@ from suds_exp.workflows.hidden_effects import (
     draw_hidden,
     hidden_effect_run,
 )
-from tests.helpers import SMALL_SWEEP, discrepancy_json, inertia_store
 
 runner = CliRunner()
 TAU = 0.2
 
 
 @pytest.fixture(scope="module")
-def inertia_db(tmp_path_factory) -> Path:
+def inertia_db(tmp_path_factory, inertia_store) -> Path:
     """A store holding a small dataset simulated with body inertia the nominal model lacks."""
     return inertia_store(tmp_path_factory.mktemp("hidden"), tau_s=TAU, seed=3)
 
 
 @pytest.fixture(scope="module")
-def cli_run(inertia_db, tmp_path_factory):
+def cli_run(inertia_db, tmp_path_factory, discrepancy_json):
     out = tmp_path_factory.mktemp("report") / "disc"
     return discrepancy_json(inertia_db, out, "--max-effects", "2", "--name", "hidden-inertia")
 
@@ -102,8 +101,8 @@ def test_report_page_is_self_contained(cli_run):
     assert (out / "steps.csv").exists() and (out / "candidates.md").exists()
 
 
-def test_demo_reports_the_hidden_effect_and_the_gap(tmp_path):
-    summary = demo_discrepancy("drag_anisotropy", seed=4, out=tmp_path / "rep", **SMALL_SWEEP)
+def test_demo_reports_the_hidden_effect_and_the_gap(tmp_path, small_sweep):
+    summary = demo_discrepancy("drag_anisotropy", seed=4, out=tmp_path / "rep", **small_sweep)
     (hidden,) = summary["hidden"]
     assert hidden == "drag_anisotropy"
     assert summary["named"][0]["effect"] == "drag_anisotropy"

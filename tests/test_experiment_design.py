@@ -181,7 +181,7 @@ def test_conditions_of_a_user_design_are_named_by_their_labels(experiment):
 
 
 def test_the_paper_design_classifies_pairs_as_results_labelled(db):
-    from tests.helpers import synthetic_samples
+    from suds_exp.testing.synthetic_samples import synthetic_samples
 
     store = Store(db)
     run_campaign(

@@ -17,7 +17,7 @@ import cli
 from suds_exp.errors import IngestError
 from suds_exp.experiment import PAPER_DESIGN, load_design
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 runner = CliRunner()
 

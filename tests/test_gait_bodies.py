@@ -19,8 +19,8 @@ from cli import app
 from suds_exp.errors import ConfigError
 from suds_exp.gait.predict import MIN_BOOT, percentile_interval
 from suds_exp.gait.shape import FourierGait, read_gait_file
+from suds_exp.testing.database import assert_same_db, dump_db
 from suds_exp.testing.kinematic_body import serial_body, write_body_trial
-from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 

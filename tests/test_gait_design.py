@@ -15,7 +15,7 @@ from cli import app
 from suds_exp.gait.shape import ellipse, paper_gaits
 from suds_exp.gait.truth import simulate_forward
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 runner = CliRunner()
 

@@ -13,7 +13,7 @@ from cli import app
 from suds_exp.errors import ConfigError
 from suds_exp.gait.motion import cycle_motion, integrate_twists, relative
 from suds_exp.gait.shape import FourierGait, ellipse, read_gait_file
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 runner = CliRunner()
 

@@ -10,7 +10,8 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from tests.helpers import assert_same_db, dump_db, qtm_text, random_track
+from suds_exp.testing.database import assert_same_db, dump_db
+from suds_exp.testing.synthetic_captures import qtm_text, random_track
 
 runner = CliRunner()
 

@@ -7,7 +7,8 @@ import pytest
 
 from suds_exp.ingest import read_capture
 from suds_exp.ingest.csv_reader import write_marker_csv
-from tests.helpers import qtm_text, random_track, write_c3d, write_motive, write_trc, write_vicon
+from suds_exp.testing.capture_files import write_c3d, write_motive, write_trc, write_vicon
+from suds_exp.testing.synthetic_captures import qtm_text, random_track
 
 
 @pytest.fixture

@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 from cli import app
 from suds_exp.preprocess import load_samples
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 load_poses = pytest.importorskip("movement.io.load_poses")
 save_poses = pytest.importorskip("movement.io.save_poses")

@@ -14,7 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 runner = CliRunner()
 

@@ -114,7 +114,8 @@ def test_campaign_refuses_bad_momentum_requests_with_the_database_unchanged(
     from suds_exp.campaign import CampaignOptions, run_campaign
     from suds_exp.errors import CampaignError
     from suds_exp.store import Store
-    from tests.helpers import dump_db, synthetic_samples
+    from suds_exp.testing.database import dump_db
+    from suds_exp.testing.synthetic_samples import synthetic_samples
 
     samples = synthetic_samples(conditions=(("O", 0.5),), trials_per_condition=2)
     if zero_velocity:

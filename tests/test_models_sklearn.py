@@ -19,8 +19,9 @@ from suds_exp.commands.campaign import parse_campaign_options
 from suds_exp.errors import ConfigError
 from suds_exp.models import make_model, model_recipe
 from suds_exp.store import Store
+from suds_exp.testing.database import dump_db
+from suds_exp.testing.synthetic_samples import synthetic_samples
 from suds_exp.testing.synthetic_swimmer import make_samples
-from tests.helpers import campaign_rows, dump_db, start_campaign, synthetic_samples, wait_batches
 
 
 class TinyRidge(RegressorMixin, BaseEstimator):
@@ -172,7 +173,7 @@ def samples_file(tmp_path_factory):
 
 @pytest.mark.slow
 def test_user_regressors_run_in_a_campaign_survive_kills_and_resume_identically(
-    tmp_path, samples_file
+    tmp_path, samples_file, campaign_rows, start_campaign, wait_batches
 ):
     samples = pd.read_parquet(samples_file)
     reference = Store(tmp_path / "reference.duckdb")

@@ -16,7 +16,7 @@ from cli import app
 from suds_exp.gait.shape import read_gait_file
 from suds_exp.plan import LoopOptions, Target, plan_next, run_loop
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 runner = CliRunner()
 

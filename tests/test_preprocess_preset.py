@@ -17,8 +17,8 @@ from suds_exp.ingest import ingest_paths
 from suds_exp.models import make_model
 from suds_exp.preprocess import PRESETS, load_samples, preprocess
 from suds_exp.store import Store
+from suds_exp.testing.database import assert_same_db, dump_db
 from suds_exp.testing.synthetic_captures import MIDDLE_MM, RIGID, synthetic_trial, write_dataset
-from tests.helpers import assert_same_db, dump_db
 
 runner = CliRunner()
 GAITS = ("S+", "S-", "O", "D-", "D+")

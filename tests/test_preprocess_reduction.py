@@ -13,7 +13,7 @@ from suds_exp.preprocess import get_version
 from suds_exp.preprocess.reduction import AutoencoderReducer, KernelPCAReducer
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, cli, dump_db, sql
+from suds_exp.testing.database import assert_same_db, dump_db
 
 
 def passive_loop(n=600, seed=0):
@@ -59,7 +59,7 @@ def test_pca_ignores_the_state_its_rate_is_linear():
     np.testing.assert_allclose(pca.transform_rate(rate, x[:5]), pca.transform_rate(rate))
 
 
-def test_reducer_versions_coexist_with_the_pca_version(dataset):  # noqa: F811
+def test_reducer_versions_coexist_with_the_pca_version(dataset, cli, sql):  # noqa: F811
     for args in ([], ["--param", "reduction=kernel-pca"], ["--param", "reduction=autoencoder"]):
         out = cli("preprocess", "--db", dataset, "--json", *args)
         assert out.exit_code == 0, out.output
@@ -105,7 +105,7 @@ def test_reducer_versions_coexist_with_the_pca_version(dataset):  # noqa: F811
     assert isinstance(get_version(store, 1).pca, PassivePCA)
 
 
-def test_bad_reduction_is_one_line_naming_the_parameter_and_changes_nothing(dataset):  # noqa: F811
+def test_bad_reduction_is_one_line_naming_the_parameter_and_changes_nothing(dataset, cli):  # noqa: F811
     assert cli("preprocess", "--db", dataset, "-q").exit_code == 0
     before = dump_db(dataset)
     out = cli("preprocess", "--db", dataset, "--param", "reduction=umap")

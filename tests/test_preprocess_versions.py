@@ -15,11 +15,11 @@ import pytest
 from suds_exp.ingest import ingest_paths
 from suds_exp.preprocess import PreprocessError, load_samples, pipeline, preprocess, sample_columns
 from suds_exp.store import Store
+from suds_exp.testing.database import assert_same_db, dump_db
 from suds_exp.testing.synthetic_captures import synthetic_trial, write_marker_csv
-from tests.helpers import assert_same_db, cli, dump_db, sql
 
 
-def test_same_parameters_make_one_version_and_rerun_skips(dataset):
+def test_same_parameters_make_one_version_and_rerun_skips(dataset, cli, sql):
     first = cli("preprocess", "--db", dataset, "--json")
     assert first.exit_code == 0, first.output
     doc = json.loads(first.stdout)
@@ -34,7 +34,7 @@ def test_same_parameters_make_one_version_and_rerun_skips(dataset):
     assert "reused" in text.stdout and "skipped 5 already done" in text.stdout
 
 
-def test_changed_parameter_makes_a_new_version_beside_the_first(dataset):
+def test_changed_parameter_makes_a_new_version_beside_the_first(dataset, cli, sql):
     assert cli("preprocess", "--db", dataset, "-q").exit_code == 0
     assert (
         cli("preprocess", "--db", dataset, "--name", "three", "--param", "k=3", "-q").exit_code == 0
@@ -161,7 +161,7 @@ def test_an_interrupted_run_resumes_with_the_trials_not_done(dataset, monkeypatc
     assert counts.n.tolist() == [800] * 5
 
 
-def test_trial_with_too_long_a_gap_is_refused_and_nothing_written(tmp_path):
+def test_trial_with_too_long_a_gap_is_refused_and_nothing_written(tmp_path, cli):
     trial = synthetic_trial("O", 0.5, n_cycles=4, seed=1)
     trial.xyz[100:160, 4] = np.nan  # tail_top_2 unseen for 0.6 s
     write_marker_csv(trial, tmp_path / "gap.csv")
@@ -189,7 +189,7 @@ def test_trial_with_too_long_a_gap_is_refused_and_nothing_written(tmp_path):
         (["--trials", "9"], "--trials: no trial with id 9"),
     ],
 )
-def test_bad_options_exit_2_and_change_nothing(dataset, args, message):
+def test_bad_options_exit_2_and_change_nothing(dataset, args, message, cli):
     before = dump_db(dataset)
     out = cli("preprocess", "--db", dataset, *args)
     assert out.exit_code == 2, out.output
@@ -197,7 +197,7 @@ def test_bad_options_exit_2_and_change_nothing(dataset, args, message):
     assert_same_db(before, dump_db(dataset))
 
 
-def test_a_name_used_by_other_parameters_is_refused(dataset):
+def test_a_name_used_by_other_parameters_is_refused(dataset, cli, sql):
     assert cli("preprocess", "--db", dataset, "--name", "base", "-q").exit_code == 0
     out = cli("preprocess", "--db", dataset, "--name", "base", "--param", "k=2")
     assert out.exit_code == 2 and "--name base: version 1 already has that name" in out.output

@@ -14,7 +14,7 @@ from cli import app
 from suds_exp.body.worm import run_worm, tracker_reference
 from suds_exp.ingest import ingest_paths
 from suds_exp.store import Store
-from tests.helpers import assert_same_db, dump_db
+from suds_exp.testing.database import assert_same_db, dump_db
 
 runner = CliRunner()
 

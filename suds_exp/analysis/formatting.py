@@ -23,6 +23,15 @@ def interval_text(value: float, low: float, high: float, digits: int = 2) -> str
     return text
 
 
+def interval_column(table: pd.DataFrame, name: str, digits: int = 2) -> list[str]:
+    """`interval_text` of every row's ``name`` and its interval (columns ``name_low`` and
+    ``name_high``): one table column of text."""
+    return [
+        interval_text(v, lo, hi, digits)
+        for v, lo, hi in zip(table[name], table[f"{name}_low"], table[f"{name}_high"], strict=True)
+    ]
+
+
 def not_measured(columns, reason: str) -> pd.DataFrame:
     """An empty table of ``columns`` that says why it is empty (``attrs["reason"]``), as
     the diagnostics return one when the data cannot give them."""

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from suds_exp.analysis.formatting import interval_text, not_measured
+from suds_exp.analysis.formatting import interval_column, not_measured
 
 #: Columns of the momentum-information table, one row per held-out frequency, then "all".
 MOMENTUM_COLUMNS = (
@@ -223,12 +223,7 @@ def momentum_display(table: pd.DataFrame) -> pd.DataFrame:
             "trials": table["n_trials"],
             "RMSE vx GMR (mm/s)": table["rmse_gmr"].map(lambda v: f"{v:.2f}"),
             "GMR+P (mm/s)": table["rmse_gmr_p"].map(lambda v: f"{v:.2f}"),
-            "ratio [95% interval]": [
-                interval_text(r, lo, hi)
-                for r, lo, hi in zip(
-                    table["ratio"], table["ratio_low"], table["ratio_high"], strict=True
-                )
-            ],
+            "ratio [95% interval]": interval_column(table, "ratio"),
             "verdict": table["verdict"],
             "tau vx, vy, wz (s)": [
                 f"{a:.3f}, {b:.3f}, {c:.3f}"

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from suds_exp.analysis.formatting import interval_text, not_measured
+from suds_exp.analysis.formatting import interval_column, not_measured
 from suds_exp.errors import AnalysisError
 
 #: What `passive_information` means, printed beside it by the demo and the report.
@@ -190,11 +190,6 @@ def passive_display(table: pd.DataFrame) -> pd.DataFrame:
             "frequency (Hz)": table["frequency_hz"].map(lambda f: f"{f:.3g}"),
             "RMSE vx, phase + r_a (mm/s)": table["rmse_ra"].map(lambda v: f"{v:.2f}"),
             "+ r_p (mm/s)": table["rmse_ra_rp"].map(lambda v: f"{v:.2f}"),
-            "gain [95% interval]": [
-                interval_text(g, lo, hi)
-                for g, lo, hi in zip(
-                    table["gain"], table["gain_low"], table["gain_high"], strict=True
-                )
-            ],
+            "gain [95% interval]": interval_column(table, "gain"),
         }
     )

@@ -16,7 +16,7 @@ from suds_exp.sim.config import SimConfig, load_config
 from suds_exp.sim.connection import local_connection, save_connection
 from suds_exp.sim.effects import apply_effects, effect_library
 from suds_exp.sim.schedule import split_effects
-from suds_exp.workflows.simulate import simulate_and_ingest
+from suds_exp.workflows.simulate import check_cycles, simulate_and_ingest
 
 
 def parse_gaits(text: str | None) -> tuple[str, ...]:
@@ -77,16 +77,6 @@ def parse_cycles(text: str | None) -> tuple[int, int]:
     return check_cycles((lo_i, hi_i), text)
 
 
-def check_cycles(cycles: tuple[int, int], text: str | None = None) -> tuple[int, int]:
-    """``cycles`` (MIN, MAX) if 1 <= MIN <= MAX, else a `ConfigError` (quoting ``text``,
-    the string it was read from, when there is one)."""
-    lo, hi = cycles
-    if not 1 <= lo <= hi:
-        shown = repr(text) if text is not None else f"({lo}, {hi})"
-        raise ConfigError(f"cycles {shown}: expected 1 <= MIN <= MAX", param="cycles")
-    return int(lo), int(hi)
-
-
 def build_config(
     config_path: Path | None, effects: Sequence[str] = (), param: str = "effects"
 ) -> SimConfig:
@@ -96,42 +86,14 @@ def build_config(
     return apply_effects(cfg, effects, param)
 
 
-def simulate_command(
-    out: Path,
-    config: SimConfig | None = None,
-    gaits: Sequence[str] = GAITS,
-    frequencies_hz: Sequence[float] = FREQUENCIES_HZ,
-    repeats: int = 4,
-    cycles: tuple[int, int] = (10, 30),
-    seed: int = 0,
-    changes: Sequence = (),
-    store=None,
-    progress: bool = False,
-) -> dict:
+def simulate_command(out: Path, store=None, progress: bool = False, **design) -> dict:
     """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary.
 
-    ``config``: the simulator (default nominal); ``cycles``: (MIN, MAX) cycles per trial;
-    ``changes``: effects switched on during each trial (`suds_exp.sim.schedule.Change`,
-    from ``NAME=VALUE@Ts`` by `split_effects`); ``progress``: a bar over the trials.
+    ``design``: the keywords of `suds_exp.workflows.simulate.simulate_and_ingest`
+    (``config``, ``gaits``, ``frequencies_hz``, ``repeats``, ``cycles``, ``seed``,
+    ``changes``), which checks them; ``progress``: a bar over the trials.
     """
-    bad = [g for g in gaits if g not in GAITS]
-    if bad or not gaits:
-        raise ConfigError(
-            f"gaits {list(gaits)!r}: expected some of {', '.join(GAITS)}", param="gaits"
-        )
-    cycles = check_cycles(tuple(cycles))
-    run = simulate_and_ingest(
-        store,
-        out,
-        config,
-        gaits=gaits,
-        frequencies_hz=frequencies_hz,
-        repeats=repeats,
-        cycles=cycles,
-        seed=seed,
-        changes=changes,
-        progress=progress,
-    )
+    run = simulate_and_ingest(store, out, progress=progress, **design)
     ds = run.dataset
     summary = {
         "out": str(out),
@@ -241,15 +203,15 @@ def simulate_options(
     static, changes = split_effects(list(effects))
     return simulate_command(
         out,
-        build_config(config_path, static),
-        gait_list,
-        freq_list,
-        repeats,
-        cycle_range,
-        seed,
-        changes,
-        store=store,
-        progress=progress,
+        store,
+        progress,
+        config=build_config(config_path, static),
+        gaits=gait_list,
+        frequencies_hz=freq_list,
+        repeats=repeats,
+        cycles=cycle_range,
+        seed=seed,
+        changes=changes,
     )
 
 

@@ -4,6 +4,9 @@
 - `synthetic_swimmer`: samples frames of a swimmer with a known motility map;
 - `synthetic_results`: `results` rows with planted effects of known size;
 - `kinematic_body`: planar bodies of rigid segments (random joint trees) and their captures.
+- `synthetic_samples`: a samples frame whose body velocity is a known quadratic map;
+- `capture_files`: C3D, TRC, Vicon Nexus and Motive files written from marker arrays;
+- `database`: whole-database snapshots (`dump_db`) and their comparison (`assert_same_db`).
 
 It sits just above what it fakes (bodies, captures, learners' results) and below the
 analyses that read such data; the pipelines built on it (the demo, the hidden-effect

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from suds_exp.errors import ConfigError
 from suds_exp.robot import FREQUENCIES_HZ, GAITS
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.dataset import SimulatedDataset, simulate_dataset
@@ -36,6 +37,16 @@ class Simulated:
         return sum(r.status == "ingested" for r in self.ingested)
 
 
+def check_cycles(cycles: tuple[int, int], text: str | None = None) -> tuple[int, int]:
+    """``cycles`` (MIN, MAX) if 1 <= MIN <= MAX, else a `ConfigError` (quoting ``text``,
+    the string it was read from, when there is one)."""
+    lo, hi = cycles
+    if not 1 <= lo <= hi:
+        shown = repr(text) if text is not None else f"({lo}, {hi})"
+        raise ConfigError(f"cycles {shown}: expected 1 <= MIN <= MAX", param="cycles")
+    return int(lo), int(hi)
+
+
 def simulate_and_ingest(
     store: Store | None,
     out: str | Path,
@@ -53,8 +64,15 @@ def simulate_and_ingest(
     The arguments are `suds_exp.sim.simulate_dataset`'s (``cycles``: (MIN, MAX) cycles per
     trial; ``changes``: effects switched on during each trial); ``store`` None only
     simulates. Ingest reads the written QTM files and their manifest, so the data takes
-    the path a real capture's does.
+    the path a real capture's does. Gaits outside `GAITS` and cycles other than
+    1 <= MIN <= MAX are a `ConfigError` (nothing written).
     """
+    bad = [g for g in gaits if g not in GAITS]
+    if bad or not gaits:
+        raise ConfigError(
+            f"gaits {list(gaits)!r}: expected some of {', '.join(GAITS)}", param="gaits"
+        )
+    cycles = check_cycles(tuple(cycles))
     start = time.perf_counter()
     ds = simulate_dataset(
         out,
