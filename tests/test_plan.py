@@ -297,7 +297,8 @@ def test_run_after_a_map_loop_leaves_out_only_what_the_loop_recorded(tmp_path):
         "simulate", "--out", str(tmp_path / "d"), "--gaits", "S+", "--freqs", "1",
         "--repeats", "1", "--cycles", "4", "--ingest", "--db", str(db), "-q",
     )  # fmt: skip
-    ok("preprocess", "--db", str(db), "-q")
+    # into the loop's version, which gives the simulated robot's motor-axis distance
+    ok("preprocess", "--db", str(db), "--param", "joint_distance_mm=100", "-q")
     r = runner.invoke(app, ["run", "m2", *args])
     assert r.exit_code != 0 and "skip-infeasible" in r.stderr
 
