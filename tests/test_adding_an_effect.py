@@ -2,8 +2,8 @@
 
 The worked example of docs/architecture.md ("Where a newcomer adds ..."): a toy effect is
 declared here (place 1: a dataclass of its parameters, registered with
-`suds_exp.sim.effect_params.effect`, whose ``kernel`` method gives the compiled solver
-its slot) and removed after the test. The config files, `suds-exp effects`, the
+`suds_exp.sim.effect_params.effect`, whose ``slot=`` gives the compiled solver its
+slot) and removed after the test. The config files, `suds-exp effects`, the
 validation of its range, the discrepancy candidates and the solver's packed parameters
 then know it. Place 2, its physics, reads ``prm[P_TOY]`` where it acts in `sim/rft.py`
 (or acts in `sim/markers.py` on the measured markers); the toy has none, so simulating
@@ -30,7 +30,13 @@ from suds_exp.sim import (
     set_effect,
     simulate_prescribed,
 )
-from suds_exp.sim.effect_params import effect, kernel_layout, main_param, unregister_effect
+from suds_exp.sim.effect_params import (
+    EFFECTS,
+    effect,
+    kernel_layout,
+    main_param,
+    unregister_effect,
+)
 from suds_exp.sim.mechanics import pack_params
 
 
@@ -38,10 +44,7 @@ from suds_exp.sim.mechanics import pack_params
 class ToyEffect:
     """Place 1: sticky beans multiply the drag by `factor` (the solver's slot ``toy.factor``)."""
 
-    factor: float = main_param(1.0, "-", 0.5, 2.0, "drag multiplier", on=1.5)
-
-    def kernel(self, units) -> dict:
-        return {"factor": self.factor}
+    factor: float = main_param(1.0, "-", 0.5, 2.0, "drag multiplier", on=1.5, slot="factor")
 
 
 @pytest.fixture
@@ -102,3 +105,16 @@ def test_a_removed_effect_is_forgotten():
         set_effect(SimConfig(), "toy=on")
     with pytest.raises(ConfigError, match="unknown setting 'toy'"):
         config_from_dict({"effects": {"toy": {"factor": 1.5}}})
+
+
+def test_an_effect_declares_its_slots_one_way():
+    @dataclass
+    class Twice:
+        factor: float = main_param(1.0, "-", 0.5, 2.0, "drag multiplier", on=1.5, slot="f")
+
+        def kernel(self, units) -> dict:
+            return {"f": self.factor}
+
+    with pytest.raises(ConfigError, match="slot= or kernel"):
+        effect("twice")(Twice)
+    assert "twice" not in EFFECTS

@@ -1,7 +1,8 @@
 """The simulator's named effects, each declared once: a dataclass of its parameters
 (unit, nominal value, realistic range and meaning in field metadata, one marked main),
-registered with `@effect(NAME)`, and, for an effect the compiled solver reads, a
-``kernel(units)`` method whose slots make up the solver's packed parameter vector.
+registered with `@effect(NAME)`, and, for an effect the compiled solver reads, its
+slots in the solver's packed parameter vector: a parameter declared with ``slot=`` (its
+value in the solver's units), or a ``kernel(units)`` method that computes them.
 
 `Effects` (the ``effects`` section of a `SimConfig`), `effect_library()`, the discrepancy
 candidates and the packed layout (`kernel_layout`, the solver's ``P_*`` indices) all
@@ -20,27 +21,72 @@ from suds_exp.errors import ConfigError
 
 
 def effect_param(
-    unit: str, low: Any, high: Any, doc: str, main: bool = False, on: Any = None, off: Any = None
+    unit: str,
+    low: Any,
+    high: Any,
+    doc: str,
+    main: bool = False,
+    on: Any = None,
+    off: Any = None,
+    slot: str | None = None,
+    scale: str | None = None,
 ) -> dict:
     """Field metadata of an effect parameter: unit, realistic range, meaning; for the
-    main parameter also its typical "on" value and its "off" value (no effect)."""
-    return {"unit": unit, "range": (low, high), "doc": doc, "main": main, "on": on, "off": off}
+    main parameter also its typical "on" value and its "off" value (no effect); for a
+    parameter the solver reads as it is, its ``slot`` and the `SLOT_SCALES` entry that
+    puts it in the solver's units."""
+    if scale not in SLOT_SCALES:
+        raise ConfigError(
+            f"slot scale {scale!r}: expected one of {', '.join(map(str, SLOT_SCALES))}"
+        )
+    return {
+        "unit": unit,
+        "range": (low, high),
+        "doc": doc,
+        "main": main,
+        "on": on,
+        "off": off,
+        "slot": slot,
+        "scale": scale,
+    }
 
 
-def param(default: Any, unit: str, low: Any, high: Any, doc: str) -> Any:
+def param(
+    default: Any,
+    unit: str,
+    low: Any,
+    high: Any,
+    doc: str,
+    slot: str | None = None,
+    scale: str | None = None,
+) -> Any:
     """A dataclass field of an effect's parameter: its nominal value, unit, realistic
-    range and meaning."""
-    return field(default=default, metadata=effect_param(unit, low, high, doc))
+    range and meaning; ``slot``/``scale`` as `effect_param`'s."""
+    return field(
+        default=default, metadata=effect_param(unit, low, high, doc, slot=slot, scale=scale)
+    )
 
 
 def main_param(
-    default: Any, unit: str, low: Any, high: Any, doc: str, on: Any, off: Any = None
+    default: Any,
+    unit: str,
+    low: Any,
+    high: Any,
+    doc: str,
+    on: Any,
+    off: Any = None,
+    slot: str | None = None,
+    scale: str | None = None,
 ) -> Any:
     """The field of an effect's main parameter (the one ``NAME=VALUE`` sets), with its
-    typical "on" value and its "off" value (no effect; by default the nominal value)."""
+    typical "on" value and its "off" value (no effect; by default the nominal value);
+    ``slot``/``scale`` as `effect_param`'s."""
     off = default if off is None else off
     return field(
-        default=default, metadata=effect_param(unit, low, high, doc, main=True, on=on, off=off)
+        default=default,
+        metadata=effect_param(
+            unit, low, high, doc, main=True, on=on, off=off, slot=slot, scale=scale
+        ),
     )
 
 
@@ -55,6 +101,28 @@ class KernelUnits:
     torque_unit_n_mm: float
 
 
+#: How a parameter declared with ``slot=`` reaches the solver: ``scale`` -> (value, units)
+#: -> the slot's value. None: as it is; "torque": N mm (or N mm s/rad) in the solver's
+#: torque unit; "per_length": a rate per metre in one per `l_ref_mm`.
+SLOT_SCALES = {
+    None: lambda value, units: value,
+    "torque": lambda value, units: value / units.torque_unit_n_mm,
+    "per_length": lambda value, units: value * units.l_ref_mm / 1000.0,
+}
+
+
+def effect_slots(eff, units: KernelUnits) -> dict:
+    """The solver's slots of effect ``eff`` (an instance), ``SLOT`` -> value(s) in the
+    solver's units: its ``kernel(units)``, else its parameters declared with ``slot=``."""
+    if hasattr(eff, "kernel"):
+        return eff.kernel(units)
+    return {
+        f.metadata["slot"]: SLOT_SCALES[f.metadata["scale"]](getattr(eff, f.name), units)
+        for f in dataclasses.fields(eff)
+        if f.metadata.get("slot")
+    }
+
+
 #: Every named effect, in the order of `Effects`' fields: name -> its dataclass.
 EFFECTS: dict[str, type] = {}
 
@@ -66,15 +134,21 @@ def effect(name: str):
     an entry of `effect_library()` and a discrepancy candidate. Class attributes:
     ``replay`` ("exact", "mean" for an effect drawn anew per trial, "none" for one acting
     between the command and the joints), ``range_checked`` (whether `validate_config`
-    holds each parameter to its declared range), and a method ``kernel(units) ->
-    {slot: value or tuple of values}`` for an effect the compiled solver reads: its
-    slots, named ``NAME.SLOT``, take their place in the packed parameter vector
-    (`kernel_layout`) from what it returns for the nominal parameters.
+    holds each parameter to its declared range). An effect the compiled solver reads
+    gives its slots, named ``NAME.SLOT``, either by declaring parameters with ``slot=``
+    (and ``scale=``, see `SLOT_SCALES`) or, for slots computed from several parameters,
+    with a method ``kernel(units) -> {slot: value or tuple of values}``; they take their
+    place in the packed parameter vector (`kernel_layout`) from the nominal parameters.
     """
 
     def register(cls: type) -> type:
         if name in EFFECTS:
             raise ConfigError(f"effect {name!r} is already registered")
+        declared = any(f.metadata.get("slot") for f in dataclasses.fields(cls))
+        if declared and hasattr(cls, "kernel"):
+            raise ConfigError(
+                f"effect {name!r}: declare its slots with slot= or kernel(), not both"
+            )
         EFFECTS[name] = cls
         _build_effects()
         return cls
@@ -131,13 +205,11 @@ class HingeDampingEffect:
     """Viscous friction in the tape hinges: flippers lag behind, more at high frequency."""
 
     damping: float = main_param(
-        0.0, "N mm s/rad", 0.0, 200.0, "viscous torque per hinge rate", on=50.0
-    )
+        0.0, "N mm s/rad", 0.0, 200.0, "viscous torque per hinge rate", on=50.0,
+        slot="c", scale="torque",
+    )  # fmt: skip
 
     range_checked: ClassVar[bool] = False
-
-    def kernel(self, units: KernelUnits) -> dict:
-        return {"c": self.damping / units.torque_unit_n_mm}
 
 
 @effect("body_inertia")
@@ -147,13 +219,10 @@ class BodyInertiaEffect:
     tau, so motion lags the shape and shrinks at high frequency (speed dependence)."""
 
     tau_s: float = main_param(
-        0.0, "s", 0.0, 0.5, "body velocity relaxes to the quasi-static one", on=0.15
+        0.0, "s", 0.0, 0.5, "body velocity relaxes to the quasi-static one", on=0.15, slot="tau"
     )
 
     range_checked: ClassVar[bool] = False
-
-    def kernel(self, units: KernelUnits) -> dict:
-        return {"tau": self.tau_s}
 
 
 @effect("asymmetric_drag")
@@ -163,13 +232,11 @@ class AsymmetricDragEffect:
     backward (grain texture, surface finish): slows or speeds the forward glide."""
 
     ratio: float = main_param(
-        1.0, "-", 0.5, 2.5, "tangential drag on the segments sliding forward / backward", on=1.8
-    )
+        1.0, "-", 0.5, 2.5, "tangential drag on the segments sliding forward / backward", on=1.8,
+        slot="ratio",
+    )  # fmt: skip
 
     range_checked: ClassVar[bool] = False
-
-    def kernel(self, units: KernelUnits) -> dict:
-        return {"ratio": self.ratio}
 
 
 @effect("drag_anisotropy")
@@ -178,12 +245,11 @@ class DragAnisotropyEffect:
     """Normal vs tangential drag ratio differs from glass beads (beans are not beads):
     scales all propulsion and the lateral slip."""
 
-    normal_scale: float = main_param(1.0, "-", 0.5, 2.0, "multiplies the normal drag C_S", on=1.5)
+    normal_scale: float = main_param(
+        1.0, "-", 0.5, 2.0, "multiplies the normal drag C_S", on=1.5, slot="normal"
+    )
 
     range_checked: ClassVar[bool] = False
-
-    def kernel(self, units: KernelUnits) -> dict:
-        return {"normal": self.normal_scale}
 
 
 @effect("medium_compaction")
@@ -193,13 +259,11 @@ class MediumCompactionEffect:
     travelled, so speed drifts along a trial."""
 
     rate_per_m: float = main_param(
-        0.0, "1/m", 0.0, 3.0, "normal drag grows by this fraction per metre travelled", on=1.5
-    )
+        0.0, "1/m", 0.0, 3.0, "normal drag grows by this fraction per metre travelled", on=1.5,
+        slot="rate", scale="per_length",
+    )  # fmt: skip
 
     range_checked: ClassVar[bool] = False
-
-    def kernel(self, units: KernelUnits) -> dict:
-        return {"rate": self.rate_per_m * units.l_ref_mm / 1000.0}
 
 
 @effect("spoke_oscillation")
@@ -439,9 +503,8 @@ def kernel_values(cfg) -> dict:
     units = kernel_units(cfg)
     values = base_kernel(cfg, units)
     for name in EFFECTS:
-        eff = getattr(cfg.effects, name)
-        if hasattr(eff, "kernel"):
-            values.update({f"{name}.{k}": v for k, v in eff.kernel(units).items()})
+        slots = effect_slots(getattr(cfg.effects, name), units)
+        values.update({f"{name}.{k}": v for k, v in slots.items()})
     return values
 
 
