@@ -172,9 +172,7 @@ def arm_plan(
             # (the loop's own ensemble seeds), whatever the loop stored when it ran
             fit_seed = derive_seed("plan-fit", loop.name, k)
             ens = MapEnsemble.fit(part, opts.learner, opts.n_boot, fit_seed)
-            now = forecast_signal(
-                part, ens, truth.target, opts.cycles, opts.learner, seed=fit_seed
-            )
+            now = forecast_signal(part, ens, truth.target, opts.cycles, opts.learner, seed=fit_seed)
             signal = now if k == 0 else latched(now, before, fired)
             before, fired = now, fired or signal.stop
             row["stop"], row["stop_reason"] = bool(signal.stop), signal.message

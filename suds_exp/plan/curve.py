@@ -280,9 +280,7 @@ def forecast_signal(
     if bias is None:
         bias = bias_variance(samples, target, learner, ensemble.point)
     members, point = ensemble.displacements(pairs)
-    noise = (
-        members.var(axis=0, ddof=1).sum(axis=1) if len(members) > 1 else np.zeros(len(pairs))
-    )
+    noise = members.var(axis=0, ddof=1).sum(axis=1) if len(members) > 1 else np.zeros(len(pairs))
     recs = recommend_map(ensemble, target, cycles, trials, samples, learner, bias)
     d = forecast_doubling(members, point, noise + bias, sum(r.score for r in recs), seed)
     doubling = (
@@ -328,9 +326,7 @@ def flattening(cycles, error, spread) -> Flattening:
         if c > 0 and later.size:
             tested.append((float(c), bool(error[i] - error[later[0]] < spread[i])))
     first = next((c for c, holds in tested if holds), None)
-    flat_from = next(
-        (c for i, (c, _) in enumerate(tested) if all(h for _, h in tested[i:])), None
-    )
+    flat_from = next((c for i, (c, _) in enumerate(tested) if all(h for _, h in tested[i:])), None)
     return Flattening(tested, first, flat_from)
 
 
