@@ -16,9 +16,15 @@ whether the next doubling of cycles will help: the planner's own model of the ta
 prediction variance (the bootstrap's noise plus the path jackknife's bias between paths,
 `suds_exp.plan.recommend`) says how much of it the trials it would choose for the next
 doubling remove; the expected error before and after is the root mean of that variance
-per target. If the expected drop is less than the bootstrap spread of the target's
-predictions, more data will not help more than noise can tell. Only the user's data
-enter (the target is the user's; nothing is simulated).
+per target. If the expected drop is less than the bootstrap spread of that error (the
+issue's "flattens": the next doubling lowers the error by less than its bootstrap
+spread), more data will not help more than noise can tell. The spread is of the RMS
+error over the target, not of single predictions (several times wider): each bootstrap
+refit's RMS error against a truth drawn from the same variance model, spread across
+refits (`error_spread`). Only the user's data enter (the target is the user's; nothing
+is simulated). The latched signal aims at the count from which the curve stays flat
+(`Flattening.flat_from`), not at the first count the definition holds at (at one
+trial the error's spread is wide enough to call almost any drop flat).
 
 `target_signal` judges the last doubling on the target instead: the
 map fitted on the first half of the recorded cycles and the map fitted on all of them
