@@ -116,6 +116,7 @@ def _preprocessed(work: Path, gaits: str) -> Path:
     return db
 
 
+@pytest.mark.slow  # three paths' jackknife refits: minutes on a loaded machine
 def test_plan_next_map_says_stop_when_the_drop_is_below_the_error_spread(tmp_path):
     db = _preprocessed(tmp_path, "O,D-,S-")
     r = runner.invoke(app, ["plan", "next", "--goal", "map", "--json", "--db", str(db)])
