@@ -57,7 +57,8 @@ from suds_exp.gait.trials import gait_trial_specs
 from suds_exp.gait.truth import simulate_forward
 from suds_exp.ingest import ingest_paths
 from suds_exp.plan import LoopOptions, Target, TargetTruth, run_loop
-from suds_exp.plan.curve import forecast_signal, latched
+from suds_exp.plan.curve import flattening as curve_flattening
+from suds_exp.plan.curve import forecast_signal, latched, within
 from suds_exp.plan.ensemble import MapEnsemble, block_draws
 from suds_exp.plan.recommend import Trial
 from suds_exp.plan.record import record_trial
@@ -137,10 +138,12 @@ def arm_random(seed: int, budget: int, cycles: int, bound: float, truth, work) -
 
 def arm_plan(
     seed: int, budget: int, goal: str, bound: float, cycles: int, work, truth=None,
-    spread_boots: int = 8,
+    spread_boots: int = 8, stored: dict[int, float] | None = None,
 ) -> list[dict]:  # fmt: skip
     """The loop's curve rows; for the map goal (``truth`` given) each row also has the
-    bootstrap spread of the map error (`error_spread`) and the loop's stop signal."""
+    bootstrap spread of the map error (`error_spread`; taken from ``stored``, cycles to
+    spread of an earlier run's curves.csv, where it has the count) and the loop's stop
+    signal."""
     opts = LoopOptions(goal=goal, bound=bound, budget_cycles=budget, seed=seed, cycles=cycles)
     store = Store(work / "plan.duckdb")
     loop = run_loop(store, opts, out=work / "plan")
@@ -161,13 +164,15 @@ def arm_plan(
         for k, row in enumerate(rows):
             part = samples[samples["trial_id"].isin(trial_ids[: k + 1])]
             key = derive_seed("flat", seed, k)
-            row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
+            if stored and row["cycles"] in stored:
+                row["error_spread_mm"] = stored[row["cycles"]]
+            else:
+                row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
             # the stopping signal as the library computes it now, from the stored data
             # (the loop's own ensemble seeds), whatever the loop stored when it ran
-            ens = MapEnsemble.fit(
-                part, opts.learner, opts.n_boot, derive_seed("plan-fit", loop.name, k)
-            )
-            now = forecast_signal(part, ens, truth.target, opts.cycles, opts.learner)
+            fit_seed = derive_seed("plan-fit", loop.name, k)
+            ens = MapEnsemble.fit(part, opts.learner, opts.n_boot, fit_seed)
+            now = forecast_signal(part, ens, truth.target, opts.cycles, opts.learner, seed=fit_seed)
             signal = now if k == 0 else latched(now, before, fired)
             before, fired = now, fired or signal.stop
             row["stop"], row["stop_reason"] = bool(signal.stop), signal.message
@@ -182,39 +187,28 @@ def error_spread(samples: pd.DataFrame, truth: TargetTruth, seed: int, n_boot: i
 
 
 def flattening(rows: list[dict]) -> dict:
-    """Where the measured map-error curve flattens and where the stop signal first fired.
-
-    Flattens at c: the first recorded count c for which the curve reaches 2 c and the
-    error at the first count >= 2 c is lower than at c by less than the bootstrap spread
-    of the error at c. The signal is within 20 % when |fired - c| <= 0.2 c."""
+    """Where the measured map-error curve flattens (`suds_exp.plan.curve.flattening`:
+    the first count where the next doubling lowers the error by less than its bootstrap
+    spread, and the count from which that holds at every later tested count) and where
+    the stop signal first fired; within 20 % when |fired - c| <= 0.2 c. The signal
+    targets ``flat_from`` (the latched signal says stop for good)."""
+    curve = curve_flattening(
+        [r["cycles"] for r in rows], [r["map_error_mm"] for r in rows],
+        [r["error_spread_mm"] for r in rows],
+    )  # fmt: skip
     flat = None
-    for r in rows:
-        later = [q for q in rows if q["cycles"] >= 2 * r["cycles"]]
-        if r["cycles"] <= 0 or not later:
-            continue
-        drop = r["map_error_mm"] - later[0]["map_error_mm"]
-        if drop < r["error_spread_mm"]:
-            flat = {"cycles": r["cycles"], "drop_mm": drop, "spread_mm": r["error_spread_mm"],
-                    "doubled_at": later[0]["cycles"]}  # fmt: skip
-            break
-    # the same test at every count: where it holds from then on (a single noisy count,
-    # such as the warm-up's with its wide spread, does not decide it)
-    tested = []
-    for r in rows:
-        later = [q for q in rows if q["cycles"] >= 2 * r["cycles"]]
-        if r["cycles"] > 0 and later:
-            drop = r["map_error_mm"] - later[0]["map_error_mm"]
-            tested.append((r["cycles"], bool(drop < r["error_spread_mm"])))
-    flat_from = next((c for i, (c, _) in enumerate(tested) if all(f for _, f in tested[i:])), None)
+    if curve.first is not None:
+        i = next(i for i, r in enumerate(rows) if r["cycles"] == curve.first)
+        later = next(q for q in rows if q["cycles"] >= 2 * rows[i]["cycles"])
+        flat = {"cycles": rows[i]["cycles"],
+                "drop_mm": rows[i]["map_error_mm"] - later["map_error_mm"],
+                "spread_mm": rows[i]["error_spread_mm"], "doubled_at": later["cycles"]}  # fmt: skip
     fired = next((r["cycles"] for r in rows if r["stop"]), None)
-    within = within_from = None
-    if flat is not None and fired is not None:
-        within = abs(fired - flat["cycles"]) <= 0.2 * flat["cycles"]
-    if flat_from is not None and fired is not None:
-        within_from = abs(fired - flat_from) <= 0.2 * flat_from
-    return {"flattens_at": flat, "signal_first_at": fired, "within_20_percent": within,
-            "flat_from": flat_from, "within_20_percent_of_flat_from": within_from,
-            "tested": tested}  # fmt: skip
+    return {"flattens_at": flat, "signal_first_at": fired,
+            "within_20_percent": within(fired, curve.first),
+            "flat_from": curve.flat_from,
+            "within_20_percent_of_flat_from": within(fired, curve.flat_from),
+            "tested": curve.tested}  # fmt: skip
 
 
 def measured_forward(gait, cycles: int, seed: int, config: SimConfig) -> float:
@@ -307,6 +301,7 @@ def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[l
             rows = arm_plan(
                 seed, budget, goal, args.bound, args.cycles, work,
                 truth if goal == "map" else None, args.spread_boots,
+                stored_spreads(args.out, seed) if args.reuse_spreads else None,
             )  # fmt: skip
         elif arm == "fullgrid":
             rows = [arm_fullgrid(seed, truth, work)]
@@ -315,6 +310,21 @@ def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[l
         else:
             rows = [arm_designer(seed, args.bound, truth, work)]
     return rows, time.perf_counter() - started
+
+
+def stored_spreads(out: Path, seed: int) -> dict[int, float]:
+    """The map-goal plan loop's error spreads (cycles to mm) of ``seed`` in an earlier
+    run's ``out``/curves.csv (empty without one): the loop's data are stored, so the
+    spreads of its counts need not be refitted when only the signal changed."""
+    path = out / "curves.csv"
+    if not path.exists():
+        return {}
+    frame = pd.read_csv(path)
+    part = frame[(frame["goal"] == "map") & (frame["arm"] == "plan") & (frame["seed"] == seed)]
+    if "error_spread_mm" not in part:
+        return {}
+    part = part.dropna(subset=["error_spread_mm"])
+    return dict(zip(part["cycles"].astype(int), part["error_spread_mm"].astype(float), strict=True))
 
 
 def first_reaching(rows: list[dict], level: float) -> int | None:
@@ -339,6 +349,10 @@ def main(argv=None) -> None:
     ap.add_argument(
         "--spread-boots", type=int, default=8,
         help="bootstrap refits of the map error's spread (the flattening check)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--reuse-spreads", action="store_true",
+        help="take the map error's spreads from --out's curves.csv where it has them",
     )  # fmt: skip
     ap.add_argument(
         "--map-arms", default="grid,random,plan",

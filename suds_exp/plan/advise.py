@@ -110,7 +110,7 @@ def plan_next(
         advice.recommendations = [rec]
         advice.files = [str(path)]
     if goal == "map":
-        advice.stop = forecast_signal(samples, ensemble, target, cycles, learner, bias)
+        advice.stop = forecast_signal(samples, ensemble, target, cycles, learner, bias, key)
     else:
         advice.stop = learning_curve(samples, learner, key)
     return advice

@@ -16,9 +16,15 @@ whether the next doubling of cycles will help: the planner's own model of the ta
 prediction variance (the bootstrap's noise plus the path jackknife's bias between paths,
 `suds_exp.plan.recommend`) says how much of it the trials it would choose for the next
 doubling remove; the expected error before and after is the root mean of that variance
-per target. If the expected drop is less than the bootstrap spread of the target's
-predictions, more data will not help more than noise can tell. Only the user's data
-enter (the target is the user's; nothing is simulated).
+per target. If the expected drop is less than the bootstrap spread of that error (the
+issue's "flattens": the next doubling lowers the error by less than its bootstrap
+spread), more data will not help more than noise can tell. The spread is of the RMS
+error over the target, not of single predictions (several times wider): each bootstrap
+refit's RMS error against a truth drawn from the same variance model, spread across
+refits (`error_spread`). Only the user's data enter (the target is the user's; nothing
+is simulated). The latched signal aims at the count from which the curve stays flat
+(`Flattening.flat_from`), not at the first count the definition holds at (at one
+trial the error's spread is wide enough to call almost any drop flat).
 
 `target_signal` judges the last doubling on the target instead: the
 map fitted on the first half of the recorded cycles and the map fitted on all of them
@@ -185,6 +191,77 @@ def target_signal(
                       change, spread)  # fmt: skip
 
 
+#: Draws of the target's unknown truth under the planner's model that the error's
+#: bootstrap spread is averaged over (`error_spread`); cheap (arrays of a few numbers).
+TRUTH_DRAWS = 200
+
+
+def error_spread(
+    members: np.ndarray, point: np.ndarray, variance: np.ndarray, seed: int = 0,
+    draws: int = TRUTH_DRAWS,
+) -> float:  # fmt: skip
+    """The bootstrap standard deviation (mm) of the target's RMS error, as the planner's
+    model expects it, from the user's data alone.
+
+    members: the bootstrap refits' net displacement per cycle (forward, lateral; mm) at
+    each target pair, (B, T, 2); point: the full fit's, (T, 2); variance: the model's
+    expected squared error of the point fit at each pair (mm^2, bootstrap noise plus
+    path-jackknife bias), (T,). The truth is unknown; under the model it is the point
+    prediction plus an error drawn N(0, variance / 2) in each of forward and lateral.
+    For each of ``draws`` such truths (seeded by ``seed``), each refit's error is the
+    RMS over the target of its distance from the truth, as the measured curve's is; the
+    spread is the root mean over the draws of those errors' variance across refits
+    (ddof 1). 0 with fewer than two refits."""
+    members = np.asarray(members, float)
+    point = np.asarray(point, float)
+    if members.shape[0] < 2:
+        return 0.0
+    sd = np.sqrt(np.maximum(np.asarray(variance, float), 0.0) / 2)[None, :, None]
+    truths = point[None] + np.random.default_rng([seed, 44]).normal(
+        size=(draws, *point.shape)
+    ) * sd  # fmt: skip
+    # (draws, B): each refit's RMS error over the target against each drawn truth
+    errors = np.sqrt(np.mean(np.sum((members[None] - truths[:, None]) ** 2, axis=3), axis=2))
+    return float(np.sqrt(np.mean(errors.var(axis=1, ddof=1))))
+
+
+@dataclass
+class Doubling:
+    """The forecast of the next doubling: the expected RMS error (mm per cycle) over the
+    target before and after it, the drop, and the error's bootstrap spread (mm);
+    ``stop`` when the drop is less than the spread."""
+
+    before_mm: float
+    after_mm: float
+    spread_mm: float
+
+    @property
+    def drop_mm(self) -> float:
+        return self.before_mm - self.after_mm
+
+    @property
+    def stop(self) -> bool:
+        return self.drop_mm < self.spread_mm
+
+
+def forecast_doubling(
+    members: np.ndarray, point: np.ndarray, variance: np.ndarray, removed: float,
+    seed: int = 0,
+) -> Doubling:  # fmt: skip
+    """The issue's "flattens" test applied to the planner's forecast: the expected error
+    is sqrt(V / T) for the total variance V = sum(variance) (mm^2) over the T target
+    pairs, after the doubling sqrt((V - removed) / T), against `error_spread` of
+    ``members``, ``point`` and ``variance`` (shapes as there)."""
+    variance = np.asarray(variance, float)
+    total = float(variance.sum())
+    removed = min(total, max(0.0, float(removed)))
+    return Doubling(
+        float(np.sqrt(total / len(variance))),
+        float(np.sqrt((total - removed) / len(variance))),
+        error_spread(members, point, variance, seed),
+    )
+
+
 def forecast_signal(
     samples: pd.DataFrame,
     ensemble: MapEnsemble,
@@ -192,42 +269,79 @@ def forecast_signal(
     cycles: int,
     learner: str = GMR,
     bias: np.ndarray | None = None,
+    seed: int = 0,
 ) -> StopSignal:
     """The map goal's stopping signal (see the module docstring): the expected drop (mm
-    per cycle) of the target's prediction error over the next doubling of the recorded
-    cycles, spent on the trials of ``cycles`` cycles `recommend_map` would choose, against
-    the RMS bootstrap standard deviation (mm) of ``ensemble``'s predictions there.
+    per cycle) of the target's RMS prediction error over the next doubling of the
+    recorded cycles, spent on the trials of ``cycles`` cycles `recommend_map` would
+    choose, against the bootstrap spread (mm) of that error (`forecast_doubling`).
 
-    The expected error is sqrt(V / T) for the total variance V (mm^2: bootstrap noise plus
-    path-jackknife bias, ``bias`` when the caller has it) over T target pairs; after the
-    doubling V less what the chosen trials remove. ``change_mm`` is the drop,
-    ``spread_mm`` the spread, ``cycles`` [now, after the doubling]."""
+    The variance per target pair is ``ensemble``'s bootstrap variance plus the
+    path-jackknife bias (``bias`` when the caller has it); the trials remove what their
+    scores say. ``change_mm`` is the drop, ``spread_mm`` the spread, ``cycles`` [now,
+    after the doubling]; ``seed`` seeds the spread's draws."""
     pairs = target.pairs()
     n = len(cycle_blocks(samples))
     trials = max(1, round(n / cycles))
     if bias is None:
         bias = bias_variance(samples, target, learner, ensemble.point)
-    noise = np.array([ensemble.displacement_spread([g], f)[0] for g, f in pairs])
+    members, point = ensemble.displacements(pairs)
+    noise = members.var(axis=0, ddof=1).sum(axis=1) if len(members) > 1 else np.zeros(len(pairs))
     recs = recommend_map(ensemble, target, cycles, trials, samples, learner, bias)
-    total = float(noise.sum() + bias.sum())
-    removed = min(total, float(sum(r.score for r in recs)))
-    before = float(np.sqrt(total / len(pairs)))
-    after = float(np.sqrt((total - removed) / len(pairs)))
-    drop, spread = before - after, float(np.sqrt(noise.mean()))
+    d = forecast_doubling(members, point, noise + bias, sum(r.score for r in recs), seed)
     doubling = (
         f"the next doubling of cycles ({n} -> {n + len(recs) * cycles}, the {len(recs)} "
-        f"trials planned) is expected to lower the target's prediction error by {drop:.2f} "
-        f"mm per cycle ({before:.2f} -> {after:.2f})"
+        f"trials planned) is expected to lower the target's prediction error by "
+        f"{d.drop_mm:.2f} mm per cycle ({d.before_mm:.2f} -> {d.after_mm:.2f})"
     )
-    if drop < spread:
+    if d.stop:
         message = (
-            f"stop: {doubling}, less than its bootstrap spread {spread:.2f} mm; more data "
-            "of this kind will not help"
+            f"stop: {doubling}, less than that error's bootstrap spread {d.spread_mm:.2f} mm; "
+            "more data of this kind will not help"
         )
     else:
-        message = f"continue: {doubling}, more than its bootstrap spread {spread:.2f} mm"
-    return StopSignal(drop < spread, message, [float(n), float(n + len(recs) * cycles)],
-                      [], [], None, drop, spread)  # fmt: skip
+        message = (
+            f"continue: {doubling}, more than that error's bootstrap spread {d.spread_mm:.2f} mm"
+        )
+    return StopSignal(d.stop, message, [float(n), float(n + len(recs) * cycles)],
+                      [], [], None, d.drop_mm, d.spread_mm)  # fmt: skip
+
+
+@dataclass
+class Flattening:
+    """Where a learning curve flattens by the definition "the next doubling of cycles
+    lowers the error by less than its bootstrap spread", tested at each count c whose
+    doubling the curve reaches. ``tested``: (c, holds) in order; ``first``: the first c
+    where it holds; ``flat_from``: the first c from which it holds at every tested count
+    (None when it holds nowhere / fails at the last)."""
+
+    tested: list[tuple[float, bool]]
+    first: float | None
+    flat_from: float | None
+
+
+def flattening(cycles, error, spread) -> Flattening:
+    """The definition (`Flattening`) on a curve: ``cycles`` the counts (increasing),
+    ``error`` the error at each (mm), ``spread`` its bootstrap standard deviation there
+    (mm). The drop of count c is the error at c less the error at the first count
+    >= 2 c."""
+    cycles, error, spread = (np.asarray(a, float) for a in (cycles, error, spread))
+    tested = []
+    for i, c in enumerate(cycles):
+        later = np.flatnonzero(cycles >= 2 * c)
+        if c > 0 and later.size:
+            tested.append((float(c), bool(error[i] - error[later[0]] < spread[i])))
+    first = next((c for c, holds in tested if holds), None)
+    flat_from = next((c for i, (c, _) in enumerate(tested) if all(h for _, h in tested[i:])), None)
+    return Flattening(tested, first, flat_from)
+
+
+def within(fired: float | None, at: float | None, share: float = 0.2) -> bool | None:
+    """Whether a signal first fired at ``fired`` cycles is within ``share`` of ``at``
+    (None when either is None)."""
+    if fired is None or at is None:
+        return None
+    return bool(abs(fired - at) <= share * at)
 
 
 def latched(now: StopSignal, before: StopSignal | None, fired: bool) -> StopSignal:

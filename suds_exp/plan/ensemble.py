@@ -76,6 +76,18 @@ class MapEnsemble:
         boots = [m.forward(gait, frequency_hz) for m in self.members]
         return point, float(np.std(boots, ddof=1)) if len(boots) > 1 else 0.0
 
+    def displacements(self, pairs: Sequence[tuple[Gait, float]]) -> tuple[np.ndarray, np.ndarray]:
+        """Net displacement per cycle (forward, lateral; mm) of each (gait, frequency Hz)
+        of ``pairs``: the refits' (len(members), len(pairs), 2) and the point fit's
+        (len(pairs), 2)."""
+
+        def xy(fitted) -> np.ndarray:
+            motions = [fitted.motion(g, f) for g, f in pairs]
+            return np.array([[m.forward_mm, m.lateral_mm] for m in motions]).reshape(-1, 2)
+
+        members = np.array([xy(m) for m in self.members]).reshape(-1, len(pairs), 2)
+        return members, xy(self.point)
+
     def displacement_spread(self, gaits: Sequence[Gait], frequency_hz: float) -> np.ndarray:
         """Bootstrap variance of each gait's net displacement per cycle (forward and
         lateral together), mm^2: array (len(gaits),)."""

@@ -226,7 +226,7 @@ class _State:
             # the path jackknife is read twice (the signal, the plan): refitted once
             self.bias = bias_variance(self.samples, target, opts.learner, self.ensemble.point)
             self.curve = forecast_signal(
-                self.samples, self.ensemble, target, opts.cycles, opts.learner, self.bias
+                self.samples, self.ensemble, target, opts.cycles, opts.learner, self.bias, seed
             )
         else:
             self.curve = learning_curve(self.samples, opts.learner, seed)
