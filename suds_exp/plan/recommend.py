@@ -35,7 +35,14 @@ Two goals:
   a new Fourier gait (written to a file) that maximises the upper confidence bound
   (point prediction + `KAPPA` x bootstrap spread) inside the joint bound and inside a
   trust region around the recorded data (the designer's `optimise_gait`); its reason is
-  the expected improvement over the best recorded gait under a normal prediction.
+  the expected improvement over the best recorded gait under a normal prediction. When
+  that step's predicted gain is below its bootstrap spread, the map cannot resolve it: the
+  trust-region search has converged on a local optimum of the map as learned so far. The
+  same bound is then searched whole (`_look_beyond`; the refits' spread grows away from
+  the data, so the upper bound rewards exploring where the map has not been told), and
+  the gait with the larger expected improvement of the two is recommended. A look beyond
+  is an extrapolation by design; the best gait reported is always a recorded one, so no
+  unrecorded prediction reaches the answer.
 """
 
 from __future__ import annotations
