@@ -396,7 +396,12 @@ def recommend_gait(
 
 
 def _look_beyond(
-    objective, support: Support, bound: float, order: int, max_evals: int, name: str,
+    objective,
+    support: Support,
+    bound: float,
+    order: int,
+    max_evals: int,
+    name: str,
     seeds: list[Gait],
 ) -> FourierGait:
     """The gait maximising ``objective`` (mm) within the joint bound alone (rad): the
