@@ -391,3 +391,32 @@ def test_a_loop_from_an_empty_database_knows_the_robots_motor_axis_distance(gait
     )
     assert json.loads(row.params.iloc[0])["joint_distance_mm"] == 100.0
     assert json.loads(row.state.iloc[0])["length_mm"] == 100.0
+
+
+def test_the_gait_goal_looks_beyond_a_trust_region_that_leaves_no_resolvable_step(small):
+    # A trust region too small for any step the map can tell from standing still is a
+    # converged local search: the planner then looks over the whole bound, where the
+    # refits' spread away from the data earns exploration, and says so.
+    from suds_exp.gait.shape import NamedGait
+    from suds_exp.gait.support import Support
+    from suds_exp.plan import MapEnsemble
+    from suds_exp.plan.recommend import expected_improvement, recommend_gait
+    from suds_exp.preprocess import get_version
+
+    samples = get_version(Store(small), "v1").samples()
+    ensemble = MapEnsemble.fit(samples, n_boot=3, seed=0)
+    support = Support.of(samples)
+    target = Target.of(bound=1.2)
+    trust = 0.001
+    rec, best, best_value = recommend_gait(
+        ensemble, support, [NamedGait("O")], target, trust, 5, "next.toml", max_evals=30
+    )
+    assert best.name == "O"
+    gait = rec.trial.gait
+    assert support.gait_distance(gait) > 10 * trust, rec.reason
+    assert "beyond the trust radius" in rec.reason
+    assert gait.max_abs() <= 1.2 + 1e-9
+    # what it reports is what the map says of the gait it recommends
+    mean, sd = ensemble.forward(gait, 0.5)
+    assert rec.score == pytest.approx(expected_improvement(mean, sd, best_value))
+    assert rec.score > expected_improvement(best_value, 0.0, best_value)

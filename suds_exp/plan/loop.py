@@ -388,6 +388,9 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
             started = time.perf_counter()
             trust = loop.iterations[-1].trust_radius or TRUST0
             rec = _plan(state, opts, target, trust, folder / f"it{it}", it)
+            # a gait goal's look beyond the trust region starts a new region: its radius
+            # is judged afresh from the first one's (the old radius measured the map elsewhere)
+            beyond = opts.goal == "gait" and _beyond(state.support, rec.trial.gait, trust)
             seed = derive_seed("plan-record", name, it) % 2**31
             trial_id = add_trial_to_version(
                 store,
@@ -404,7 +407,7 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
                 fired = any(i.stop for i in loop.iterations)
                 state.curve = latched(state.raw_curve, signal_before, fired)
             if opts.goal == "gait":
-                trust = _next_trust(trust, rec, state, target, before)
+                trust = _next_trust(TRUST0 if beyond else trust, rec, state, target, before)
             recorded += rec.trial.cycles
             row = _iteration(
                 it,
@@ -478,6 +481,12 @@ def _plan(state: _State, opts: LoopOptions, target: Target, trust: float, folder
     }
     saved.write_text(json.dumps(doc))
     return rec
+
+
+def _beyond(support, gait: Gait, trust: float) -> bool:
+    """Whether the planned gait lies beyond the trust radius (rad) of the data it was
+    planned on (the search inside it keeps to the radius up to its last rounding)."""
+    return support.gait_distance(gait) > 1.01 * trust
 
 
 def _next_trust(trust, rec, state, target, before) -> float:

@@ -35,7 +35,14 @@ Two goals:
   a new Fourier gait (written to a file) that maximises the upper confidence bound
   (point prediction + `KAPPA` x bootstrap spread) inside the joint bound and inside a
   trust region around the recorded data (the designer's `optimise_gait`); its reason is
-  the expected improvement over the best recorded gait under a normal prediction.
+  the expected improvement over the best recorded gait under a normal prediction. When
+  that step's predicted gain is below its bootstrap spread, the map cannot resolve it: the
+  trust-region search has converged on a local optimum of the map as learned so far. The
+  same bound is then searched whole (`_look_beyond`; the refits' spread grows away from
+  the data, so the upper bound rewards exploring where the map has not been told), and
+  the gait with the larger expected improvement of the two is recommended. A look beyond
+  is an extrapolation by design; the best gait reported is always a recorded one, so no
+  unrecorded prediction reaches the answer.
 """
 
 from __future__ import annotations
@@ -63,6 +70,13 @@ KAPPA = 1.0
 VISIT_RADIUS = SHAPE_RADIUS
 #: Starting lags (rad) of the gait search's circles beside the best recorded gait.
 START_LAGS_RAD = (-0.6, 0.0, 0.6)
+#: The look over the whole bound: circles of these radii (fractions of the bound) at
+#: these lags (rad) are scored first, and the search starts from the `GLOBAL_STARTS`
+#: best of them (a grid of the one-harmonic gaits, chosen as the span of amplitude and
+#: tilt, not from any simulated result).
+GLOBAL_RADII_OF_BOUND = (0.5, 0.75, 1.0)
+GLOBAL_LAGS_RAD = (-1.2, -0.9, -0.6, -0.3, 0.0, 0.3, 0.6, 0.9, 1.2)
+GLOBAL_STARTS = 2
 
 
 @dataclass
@@ -358,12 +372,52 @@ def recommend_gait(
     gait, _ = optimise_gait(ucb, support, target.bound, trust, starts, max_evals, name)
     mean, sd = ensemble.forward(gait, freq)
     ei = expected_improvement(mean, sd, best_value)
+    where = f"trust radius {trust:.2f} rad"
+    if mean - best_value < sd:
+        # The map cannot tell the best step inside the trust region from standing still:
+        # the local search has converged on the map as learned so far. Look over the whole
+        # bound, where the refits' spread grows away from the data and earns exploration;
+        # the trial's own recording then teaches the map there.
+        far = _look_beyond(ucb, support, target.bound, order, max_evals, name, [gait, best_gait])
+        far_mean, far_sd = ensemble.forward(far, freq)
+        far_ei = expected_improvement(far_mean, far_sd, best_value)
+        if far_ei > ei:
+            where = (
+                f"beyond the trust radius {trust:.2f} rad, whose best step was predicted "
+                f"{mean:.1f} +/- {sd:.1f} (expected improvement {ei:.2f})"
+            )
+            gait, mean, sd, ei = far, far_mean, far_sd, far_ei
     reason = (
         f"predicted {mean:.1f} +/- {sd:.1f} mm/cycle against the best recorded gait's "
-        f"{best_value:.1f}: expected improvement {ei:.2f} mm/cycle (trust radius {trust:.2f} rad)"
+        f"{best_value:.1f}: expected improvement {ei:.2f} mm/cycle ({where})"
     )
     rec = Recommendation(Trial(gait, freq, cycles, name), ei, "mm/cycle", reason, mean, sd)
     return rec, best_gait, best_value
+
+
+def _look_beyond(
+    objective,
+    support: Support,
+    bound: float,
+    order: int,
+    max_evals: int,
+    name: str,
+    seeds: list[Gait],
+) -> FourierGait:
+    """The gait maximising ``objective`` (mm) within the joint bound alone (rad): the
+    circles of `GLOBAL_RADII_OF_BOUND` x `GLOBAL_LAGS_RAD` and ``seeds`` (Fourier gaits of
+    ``order``; others are left out) are scored, and the search starts from the
+    `GLOBAL_STARTS` best."""
+    grid = [
+        within_bound(circle(f * bound, order, lag=lag), bound)
+        for f in GLOBAL_RADII_OF_BOUND
+        for lag in GLOBAL_LAGS_RAD
+    ]
+    grid += [g for g in seeds if isinstance(g, FourierGait) and g.order == order]
+    scores = [objective(g) for g in grid]
+    starts = [grid[i] for i in np.argsort(scores)[::-1][:GLOBAL_STARTS]]
+    gait, _ = optimise_gait(objective, support, bound, np.inf, starts, max_evals, name)
+    return gait
 
 
 def _inside(gait: FourierGait, support: Support, bound: float, trust: float) -> FourierGait:
