@@ -69,10 +69,11 @@ BATCH_ROWS = 1000
 FLUSH_SECONDS = 10.0
 #: How long to wait for a dask scheduler to answer before refusing the run, in s.
 SCHEDULER_WAIT_S = 5.0
-#: On dask, the jobs left are cut into about this many tasks per worker thread ...
+#: On dask, a task holds about this many seconds of jobs (their fit + predict time, from
+#: the rows of the tasks finished so far; the first tasks are one draw each) ...
+DASK_TASK_SECONDS = 0.25
+#: ... and at most the jobs left / (worker threads x this), so the run's end stays even.
 DASK_TASKS_PER_THREAD = 8
-#: ... of at most this many jobs each (a killed worker's task is run again elsewhere).
-DASK_MAX_TASK_JOBS = 200
 
 
 @dataclass(repr=False)
@@ -198,8 +199,7 @@ def run_campaign(
         cluster of ``jobs`` single-threaded workers.
     chunk_jobs : int, optional
         Jobs per task sent to a worker (default: loky, enough for ~30 tasks per worker,
-        1-32; dask, `DASK_TASKS_PER_THREAD` tasks per thread of the cluster, at most
-        `DASK_MAX_TASK_JOBS` jobs each).
+        1-32; dask, `DASK_TASK_SECONDS` of work a task, see `DASK_TASKS_PER_THREAD`).
     batch_rows, flush_seconds : int, float
         Write finished rows when this many are waiting or this long after the last write.
     progress : bool
@@ -424,8 +424,8 @@ def _results_iter(bank, chunks, plan, how: _How, pending: int, stack: contextlib
     if how.backend == "dask":
         client = _dask_client(how.scheduler, jobs, stack)
         threads = _cluster_threads(client)
-        size = how.chunk_jobs or _dask_task_jobs(pending, threads)
-        return _dask_rows(client, bank, _regroup(chunks, size), args, threads, stack)
+        sizer = _TaskSizer(pending, threads, how.chunk_jobs)
+        return _dask_rows(client, bank, _regroup(chunks, sizer), args, sizer, stack)
     if jobs == 1:
         stack.enter_context(threadpool_limits(limits=1))
         return (run_chunk(bank, c, *args, blas="none") for c in chunks)
@@ -476,28 +476,46 @@ def _cluster_threads(client) -> int:
     return max(1, sum(client.nthreads().values()))
 
 
-def _dask_task_jobs(pending: int, threads: int) -> int:
-    """Jobs per dask task for ``pending`` jobs on ``threads`` worker threads.
+class _TaskSizer:
+    """Jobs per dask task: `DASK_TASK_SECONDS` of fit + predict time at the mean job time
+    seen so far, at most the jobs pending at the start / (threads x
+    `DASK_TASKS_PER_THREAD`); ``fixed`` (``chunk_jobs``) overrides both.
 
-    A job of a five-cycle campaign takes ~12 ms; one task a job (or a draw) would pay
-    the scheduler's round trip, the task's (de)serialisation and the worker's event loop
-    hundreds of times for little work each (dask advises tasks of 100 ms or more). A few
-    tasks per thread keep the end of the run even (draws with the most cycles come first)
-    and the work a killed worker takes with it small.
-    """
-    return int(
-        min(DASK_MAX_TASK_JOBS, max(1, math.ceil(pending / (threads * DASK_TASKS_PER_THREAD))))
-    )
+    A job of a five-cycle campaign takes ~12 ms: one task a draw would pay the scheduler's
+    round trip, the task's (de)serialisation and the worker's event loop hundreds of times
+    for little work each (dask advises tasks of 100 ms or more). Tasks of a fraction of a
+    second keep the end of the run even (draws with the most cycles come first), the work
+    a killed worker takes with it small, and a Ctrl-C quick (a stopping local worker
+    finishes its task first)."""
+
+    def __init__(self, pending: int, threads: int, fixed: int | None = None):
+        self.fixed = fixed
+        self.cap = max(1, math.ceil(pending / (threads * DASK_TASKS_PER_THREAD)))
+        self.threads = threads
+        self.jobs = 0
+        self.seconds = 0.0
+
+    def seen(self, rows: list[dict]) -> None:
+        self.jobs += len(rows)
+        self.seconds += sum(r["fit_seconds"] + r["predict_seconds"] for r in rows)
+
+    def size(self) -> int:
+        if self.fixed:
+            return self.fixed
+        if not self.jobs or self.seconds <= 0:
+            return 1  # one draw: its learners stay together
+        return int(min(self.cap, max(1, DASK_TASK_SECONDS * self.jobs / self.seconds)))
 
 
-def _regroup(chunks, size: int) -> Iterator[list]:
-    """The draws of ``chunks`` in chunks of about ``size`` jobs (a draw's learners together)."""
+def _regroup(chunks, sizer: _TaskSizer) -> Iterator[list]:
+    """The draws of ``chunks`` in chunks of about ``sizer.size()`` jobs, a draw's learners
+    together (the size read as each task is made)."""
     current: list = []
     n = 0
     for chunk in chunks:
         current.extend(chunk)
         n += sum(len(names) for _, names in chunk)
-        if n >= size:
+        if n >= sizer.size():
             yield current
             current, n = [], 0
     if current:
@@ -508,7 +526,7 @@ def _regroup(chunks, size: int) -> Iterator[list]:
 THREADS_POLL_S = 5.0
 
 
-def _dask_rows(client, bank, tasks, args, threads: int, stack: contextlib.ExitStack):
+def _dask_rows(client, bank, tasks, args, sizer: _TaskSizer, stack: contextlib.ExitStack):
     """Rows of each task of ``tasks`` as it finishes on ``client``'s cluster.
 
     Submitted straight to the scheduler (not through joblib, whose dask backend runs every
@@ -535,15 +553,29 @@ def _dask_rows(client, bank, tasks, args, threads: int, stack: contextlib.ExitSt
         for chunk in itertools.islice(tasks, max(0, n)):
             running.add(client.submit(run_chunk, shared, chunk, *args, blas="block", pure=False))
 
-    submit(2 * threads)
+    submit(2 * sizer.threads)
     check = time.monotonic() + THREADS_POLL_S
     for future in running:
         rows = future.result()
         future.release()
+        sizer.seen(rows)
         if time.monotonic() >= check:  # workers that joined since the start get work too
-            threads, check = _cluster_threads(client), time.monotonic() + THREADS_POLL_S
-        submit(2 * threads - running.count())
+            sizer.threads, check = _cluster_threads(client), time.monotonic() + THREADS_POLL_S
+        submit(2 * sizer.threads - running.count())
         yield rows
+
+
+@contextlib.contextmanager
+def _closed_shielded(signals: _Signals) -> Iterator[contextlib.ExitStack]:
+    """An exit stack closed with Ctrl-C held back: stopping a cluster's client and workers
+    takes seconds on a loaded machine, and a Ctrl-C pressed again meanwhile would leave
+    them to the interpreter's exit, which prints its own traceback."""
+    stack = contextlib.ExitStack()
+    try:
+        yield stack
+    finally:
+        with signals.shielded():
+            stack.close()
 
 
 @contextlib.contextmanager
@@ -680,7 +712,7 @@ def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
     ):
         last = time.monotonic()
         try:
-            with contextlib.ExitStack() as stack:
+            with _closed_shielded(signals) as stack:
                 # a cluster stopped while it starts fails on its own assertions: a
                 # Ctrl-C then is served once it is up
                 with signals.shielded():
