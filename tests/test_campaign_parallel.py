@@ -57,3 +57,33 @@ def test_a_two_process_dask_local_cluster_gives_the_rows_of_one_worker(
             scheduler=cluster.scheduler_address,
         )
     pd.testing.assert_frame_equal(rows, reference, check_exact=True)
+
+
+def test_a_one_thread_dask_cluster_runs_the_jobs_on_its_worker_a_few_draws_a_task(
+    tmp_path, samples, reference
+):
+    distributed = pytest.importorskip("dask.distributed")
+    store = Store(tmp_path / "x.duckdb")
+    with (
+        distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+        distributed.get_task_stream(client) as stream,
+    ):
+        summary = run_campaign(
+            store,
+            "c",
+            CampaignOptions(**OPTIONS),
+            samples=samples,
+            backend="dask",
+            scheduler=cluster.scheduler_address,
+            progress=False,
+        )
+        workers = set(client.scheduler_info()["workers"])
+    assert summary.done_now == N_JOBS
+    pd.testing.assert_frame_equal(campaign_rows(store), reference, check_exact=True)
+    # every job ran on the worker, not in this process, in fewer tasks than draws
+    tasks = [t for t in stream.data if t["key"].startswith("run_chunk")]
+    assert 1 < len(tasks) < N_JOBS // len(OPTIONS["models"])
+    assert {t["worker"] for t in tasks} == workers

@@ -6,7 +6,7 @@ the rows agree.
 Usage::
 
     .venv/bin/python -m benchmarks.speed.dask_scaling                  # a small dataset
-    .venv/bin/python -m benchmarks.speed.dask_scaling --boots 10 --rounds 3
+    .venv/bin/python -m benchmarks.speed.dask_scaling --boots 15 --rounds 2    # ~2 min idle
     .venv/bin/python -m benchmarks.speed.dask_scaling \
         --worker-env DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False
 
@@ -18,13 +18,15 @@ in turn: ``suds-exp run`` in-process (``-j 1``), with loky (``-j 2``), and with
 suds_exp.campaign.dask_worker`` processes, 1 and 2 of them by default; ``--nanny`` keeps
 dask's nanny process), stopped after each run.
 ``--worker-env`` sets environment variables of the dask workers only (to test what slows
-them down). Figures are medians over
-``--rounds``; "job" is a job's ``fit_seconds + predict_seconds`` as the results table
-stores it; "client CPU" is the ``suds-exp run`` process's CPU time (user + system, its
-start-up included: imports, samples, plan; ~3 s on a 2-core machine) and
-its share of the CPU time of the client, the scheduler and the workers together during
-the run (read from ``/proc``, so dask rows only, on Linux). ``--quick``: phase-only, one
-draw of 2 cycles, one dask worker (a smoke run).
+them down). Figures are medians over ``--rounds``; "job" is a job's ``fit_seconds +
+predict_seconds`` as the results table stores it; "client CPU" is the ``suds-exp run``
+process's CPU time (user + system, its start-up included: imports, samples, plan; ~3 s on
+a 2-core machine) and its share of the CPU time of the client, the scheduler and the
+workers together during the run (read from ``/proc``, so dask rows only, on Linux);
+"tasks" is the number of campaign tasks the cluster ran and "task s" their median compute
+time (the scheduler's task stream; a task is a batch of draws, see ``run_campaign``'s
+``chunk_jobs``). ``--quick``: phase-only, one draw of 2 cycles, one dask worker (a smoke
+run). ``--workers 2`` leaves the one-worker cluster out (a shorter run).
 """
 
 from __future__ import annotations
@@ -129,6 +131,21 @@ class _Cluster:
 
         with Client(self.address, timeout=30) as client:
             client.wait_for_workers(n, timeout=60)
+            client.get_task_stream()  # the scheduler records every task from now on
+
+    def tasks(self) -> list[float]:
+        """Compute seconds of each campaign task the cluster ran (its task stream)."""
+        from dask.distributed import Client
+
+        with Client(self.address, timeout=30) as client:
+            stream = client.get_task_stream()
+        return [
+            ss["stop"] - ss["start"]
+            for t in stream
+            if t["key"].startswith("run_chunk")
+            for ss in t["startstops"]
+            if ss["action"] == "compute"
+        ]
 
     def stop(self) -> None:
         for p in [*self.workers, self.scheduler]:
@@ -179,6 +196,7 @@ def _run(
     # the run's process and, with loky, its workers (reaped by it)
     client = (after.ru_utime + after.ru_stime) - (children.ru_utime + children.ru_stime)
     cluster_cpu = sum(_cpu_s(p) - c for p, c in zip(pids, others, strict=True))
+    tasks = cluster.tasks() if cluster else []
     with duckdb.connect(str(db), read_only=True) as con:
         job = con.sql("SELECT median(fit_seconds + predict_seconds) FROM results").fetchone()[0]
         rows = con.sql(
@@ -193,6 +211,8 @@ def _run(
         "digest": digest,
         "client_cpu": client,
         "share": client / (client + cluster_cpu) if cluster else float("nan"),
+        "tasks": len(tasks),
+        "task_s": median(tasks) if tasks else float("nan"),
     }
 
 
@@ -227,7 +247,7 @@ def main(argv=None) -> int:
                         folder,
                         f"dask{n}",
                         a,
-                        ["--backend", "dask", "--scheduler", cluster.address, "-j", str(n)],
+                        ["--backend", "dask", "--scheduler", cluster.address],
                         cluster,
                     )
                 finally:
@@ -242,16 +262,18 @@ def main(argv=None) -> int:
     )
     print(
         f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11} "
-        f"{'client CPU s':>12} {'share':>6}  rows"
+        f"{'client CPU s':>12} {'share':>6} {'tasks':>5} {'task s':>6}  rows"
     )
     for label, rs in runs.items():
         wall, job = median(r["wall"] for r in rs), median(r["job_ms"] for r in rs)
         client, share = median(r["client_cpu"] for r in rs), median(r["share"] for r in rs)
         share_text = f"{share:6.1%}" if share == share else f"{'':6}"
+        tasks, task_s = median(r["tasks"] for r in rs), median(r["task_s"] for r in rs)
+        task_text = f"{tasks:5.0f} {task_s:6.2f}" if tasks else f"{'':5} {'':6}"
         same = "same" if {r["digest"] for r in rs} == {ref[0]["digest"]} else "DIFFER"
         print(
             f"{label:26} {wall:7.1f} {ref_wall / wall:7.2f}x {job:7.1f} {job / ref_job:10.2f}x "
-            f"{client:12.2f} {share_text}  {same}"
+            f"{client:12.2f} {share_text} {task_text}  {same}"
         )
     return 0
 

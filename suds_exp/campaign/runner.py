@@ -1,11 +1,12 @@
 """`run_campaign`: create or continue a campaign and fill its `results` rows.
 
 The parent process loads the samples once, builds the `SampleBank`, works out which jobs
-are not finished yet, and hands chunks of draws to joblib workers (loky processes on this
-machine, or a dask.distributed cluster). Finished rows come back to the parent, which
-writes them in batches, each batch in one transaction, holding the database file only
-while it writes, so `suds-exp status`, `suds-exp sql` and `duckdb -readonly` can read in
-between. A file lock beside the database keeps a second run out.
+are not finished yet, and hands chunks of draws to workers (loky processes on this machine
+through joblib, or the threads of a dask.distributed cluster, a few tasks a thread).
+Finished rows come back to the parent, which writes them in batches, each batch in one
+transaction, holding the database file only while it writes, so `suds-exp status`,
+`suds-exp sql` and `duckdb -readonly` can read in between. A file lock beside the
+database keeps a second run out.
 
 Stopping: Ctrl-C (or SIGTERM) stops after writing every row already received; a signal
 that arrives while a batch is being written is served after the write, so a batch is
@@ -18,6 +19,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import dataclasses
+import itertools
 import json
 import logging
 import math
@@ -67,6 +69,11 @@ BATCH_ROWS = 1000
 FLUSH_SECONDS = 10.0
 #: How long to wait for a dask scheduler to answer before refusing the run, in s.
 SCHEDULER_WAIT_S = 5.0
+#: On dask, a task holds about this many seconds of jobs (their fit + predict time, from
+#: the rows of the tasks finished so far; the first tasks are one draw each) ...
+DASK_TASK_SECONDS = 0.25
+#: ... and at most the jobs left / (worker threads x this), so the run's end stays even.
+DASK_TASKS_PER_THREAD = 8
 
 
 @dataclass(repr=False)
@@ -191,7 +198,8 @@ def run_campaign(
         dask scheduler address (``tcp://host:8786``); None with dask starts a local
         cluster of ``jobs`` single-threaded workers.
     chunk_jobs : int, optional
-        Jobs per task sent to a worker (default: enough for ~30 tasks per worker, 1-32).
+        Jobs per task sent to a worker (default: loky, enough for ~30 tasks per worker,
+        1-32; dask, `DASK_TASK_SECONDS` of work a task, see `DASK_TASKS_PER_THREAD`).
     batch_rows, flush_seconds : int, float
         Write finished rows when this many are waiting or this long after the last write.
     progress : bool
@@ -221,8 +229,11 @@ def run_campaign(
             stored_design(store).added_labels | added_conditions(store),
         )
         n_workers = _n_workers(jobs)
+        # dask: one draw a chunk here, grouped into tasks once the cluster's size is known
         chunks, total, pending = pending_jobs(
-            store, plan, chunk_jobs or _default_chunk(plan, n_workers)
+            store,
+            plan,
+            chunk_jobs or (1 if backend == "dask" else _default_chunk(plan, n_workers)),
         )
         if total == 0:
             raise CampaignError(
@@ -237,7 +248,9 @@ def run_campaign(
         summary.extra["skipped_cells"] = plan.definition.get("skipped_cells", [])
         _record_start(store, plan, stored is None, total, backend, n_workers, pending)
         if pending:
-            how = _How(jobs, backend, scheduler, batch_rows, flush_seconds, progress, on_batch)
+            how = _How(
+                jobs, backend, scheduler, batch_rows, flush_seconds, progress, on_batch, chunk_jobs
+            )
             _execute(store, plan, bank, chunks, summary, how)
     summary.seconds = time.perf_counter() - started
     return summary
@@ -405,53 +418,164 @@ class _Signals:
             raise KeyboardInterrupt
 
 
-def _results_iter(bank, chunks, plan, jobs, backend, scheduler, stack: contextlib.ExitStack):
+def _results_iter(bank, chunks, plan, how: _How, pending: int, stack: contextlib.ExitStack):
     args = (plan.models, plan.test_cycles)
-    if backend == "loky" and jobs == 1:
+    jobs = how.jobs
+    if how.backend == "dask":
+        client = _dask_client(how.scheduler, jobs, stack)
+        threads = _cluster_threads(client)
+        sizer = _TaskSizer(pending, threads, how.chunk_jobs)
+        return _dask_rows(client, bank, _regroup(chunks, sizer), args, sizer, stack)
+    if jobs == 1:
         stack.enter_context(threadpool_limits(limits=1))
         return (run_chunk(bank, c, *args, blas="none") for c in chunks)
     from joblib import Parallel, delayed, parallel_config
 
-    if backend == "loky":
-        shared = bank.memmapped(_bank_folder(stack))
-        stack.enter_context(parallel_config(backend="loky", n_jobs=jobs))
-    else:
-        from dask.distributed import Client, LocalCluster
-
-        if scheduler:
-            # a lost scheduler is one line (`ClusterLostError`), not the client's logged
-            # reconnect tracebacks, nor tornado's of a result being gathered then (a
-            # callback of the client's loop: 45 lines, seen in the cluster test)
-            stack.enter_context(_quiet_logger("distributed"))
-            stack.enter_context(_quiet_logger("tornado"))
-            stack.enter_context(Client(scheduler, timeout=SCHEDULER_WAIT_S))
-        else:
-            with _sigint_blocked():
-                cluster = LocalCluster(
-                    n_workers=_n_workers(jobs),
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address=None,
-                    # workers ignore Ctrl-C: this process stops the run (dask_worker.py)
-                    preload=["suds_exp.campaign.dask_worker"],
-                    # closing busy workers is not worth a warning on the terminal
-                    silence_logs=logging.ERROR,
-                )
-            stack.enter_context(cluster)
-            stack.enter_context(Client(cluster))
-        # Scattered once to every worker; joblib swaps the argument for its future.
-        shared = bank
-        stack.enter_context(parallel_config(backend="dask", n_jobs=jobs, scatter=[bank]))
+    shared = bank.memmapped(_bank_folder(stack))
+    stack.enter_context(parallel_config(backend="loky", n_jobs=jobs))
     # loky workers end with this process, even after kill -9 (see `job.watch_parent`)
-    worker_args = {"blas": "pin", "parent": os.getpid()} if backend == "loky" else {"blas": "block"}
-    # loky starts its workers here, with SIGINT ignored like dask's (`_sigint_blocked`);
-    # dask's are up already, and this call may take a while (scatter)
-    with _sigint_blocked() if backend == "loky" else contextlib.nullcontext():
+    worker_args = {"blas": "pin", "parent": os.getpid()}
+    # loky starts its workers here, with SIGINT ignored like dask's (`_sigint_blocked`)
+    with _sigint_blocked():
         gen = Parallel(return_as="generator_unordered", batch_size=1, pre_dispatch="2*n_jobs")(
             delayed(run_chunk)(shared, c, *args, **worker_args) for c in chunks
         )
     stack.callback(getattr(gen, "close", lambda: None))
     return gen
+
+
+def _dask_client(scheduler: str | None, jobs: int, stack: contextlib.ExitStack):
+    """A dask.distributed client of the cluster at ``scheduler``, or of a local cluster of
+    ``jobs`` one-thread worker processes; both closed with ``stack``."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        # a lost scheduler is one line (`ClusterLostError`), not the client's logged
+        # reconnect tracebacks, nor tornado's of a result being gathered then (a
+        # callback of the client's loop: 45 lines, seen in the cluster test)
+        stack.enter_context(_quiet_logger("distributed"))
+        stack.enter_context(_quiet_logger("tornado"))
+        return stack.enter_context(Client(scheduler, timeout=SCHEDULER_WAIT_S))
+    with _sigint_blocked():
+        cluster = LocalCluster(
+            n_workers=_n_workers(jobs),
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            # workers ignore Ctrl-C: this process stops the run (dask_worker.py)
+            preload=["suds_exp.campaign.dask_worker"],
+            # closing busy workers is not worth a warning on the terminal
+            silence_logs=logging.ERROR,
+        )
+    stack.enter_context(cluster)
+    return stack.enter_context(Client(cluster))
+
+
+def _cluster_threads(client) -> int:
+    """Worker threads of ``client``'s cluster now (at least 1: workers may join later)."""
+    return max(1, sum(client.nthreads().values()))
+
+
+class _TaskSizer:
+    """Jobs per dask task: `DASK_TASK_SECONDS` of fit + predict time at the mean job time
+    seen so far, at most the jobs pending at the start / (threads x
+    `DASK_TASKS_PER_THREAD`); ``fixed`` (``chunk_jobs``) overrides both.
+
+    A job of a five-cycle campaign takes ~12 ms: one task a draw would pay the scheduler's
+    round trip, the task's (de)serialisation and the worker's event loop hundreds of times
+    for little work each (dask advises tasks of 100 ms or more). Tasks of a fraction of a
+    second keep the end of the run even (draws with the most cycles come first), the work
+    a killed worker takes with it small, and a Ctrl-C quick (a stopping local worker
+    finishes its task first)."""
+
+    def __init__(self, pending: int, threads: int, fixed: int | None = None):
+        self.fixed = fixed
+        self.cap = max(1, math.ceil(pending / (threads * DASK_TASKS_PER_THREAD)))
+        self.threads = threads
+        self.jobs = 0
+        self.seconds = 0.0
+
+    def seen(self, rows: list[dict]) -> None:
+        self.jobs += len(rows)
+        self.seconds += sum(r["fit_seconds"] + r["predict_seconds"] for r in rows)
+
+    def size(self) -> int:
+        if self.fixed:
+            return self.fixed
+        if not self.jobs or self.seconds <= 0:
+            return 1  # one draw: its learners stay together
+        return int(min(self.cap, max(1, DASK_TASK_SECONDS * self.jobs / self.seconds)))
+
+
+def _regroup(chunks, sizer: _TaskSizer) -> Iterator[list]:
+    """The draws of ``chunks`` in chunks of about ``sizer.size()`` jobs, a draw's learners
+    together (the size read as each task is made)."""
+    current: list = []
+    n = 0
+    for chunk in chunks:
+        current.extend(chunk)
+        n += sum(len(names) for _, names in chunk)
+        if n >= sizer.size():
+            yield current
+            current, n = [], 0
+    if current:
+        yield current
+
+
+#: How often the dask path asks the scheduler how many worker threads there are, in s.
+THREADS_POLL_S = 5.0
+
+
+def _dask_rows(client, bank, tasks, args, sizer: _TaskSizer, stack: contextlib.ExitStack):
+    """Rows of each task of ``tasks`` as it finishes on ``client``'s cluster.
+
+    Submitted straight to the scheduler (not through joblib, whose dask backend runs every
+    task in this process when the cluster has a single thread), two tasks a worker thread
+    at a time, so the chunks of a large campaign are built as they are sent. The bank is
+    scattered to every worker once; a worker that dies takes its task with it and the
+    scheduler runs that task again on another (the rows are the same: seeds come from
+    each job's key).
+    """
+    from dask.distributed import as_completed
+
+    shared = client.scatter(bank, broadcast=True, hash=False)
+    running = as_completed()
+    tasks = iter(tasks)
+
+    def cancel() -> None:
+        if client.status == "running":
+            with contextlib.suppress(Exception):
+                client.cancel(list(running.futures), asynchronous=False)
+
+    stack.callback(cancel)
+
+    def submit(n: int) -> None:
+        for chunk in itertools.islice(tasks, max(0, n)):
+            running.add(client.submit(run_chunk, shared, chunk, *args, blas="block", pure=False))
+
+    submit(2 * sizer.threads)
+    check = time.monotonic() + THREADS_POLL_S
+    for future in running:
+        rows = future.result()
+        future.release()
+        sizer.seen(rows)
+        if time.monotonic() >= check:  # workers that joined since the start get work too
+            sizer.threads, check = _cluster_threads(client), time.monotonic() + THREADS_POLL_S
+        submit(2 * sizer.threads - running.count())
+        yield rows
+
+
+@contextlib.contextmanager
+def _closed_shielded(signals: _Signals) -> Iterator[contextlib.ExitStack]:
+    """An exit stack closed with Ctrl-C held back: stopping a cluster's client and workers
+    takes seconds on a loaded machine, and a Ctrl-C pressed again meanwhile would leave
+    them to the interpreter's exit, which prints its own traceback."""
+    stack = contextlib.ExitStack()
+    try:
+        yield stack
+    finally:
+        with signals.shielded():
+            stack.close()
 
 
 @contextlib.contextmanager
@@ -546,6 +670,7 @@ class _How:
     flush_seconds: float
     progress: bool
     on_batch: object
+    chunk_jobs: int | None = None
 
 
 def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
@@ -587,12 +712,12 @@ def _execute(store, plan, bank, chunks, summary, how: _How) -> None:
     ):
         last = time.monotonic()
         try:
-            with contextlib.ExitStack() as stack:
+            with _closed_shielded(signals) as stack:
                 # a cluster stopped while it starts fails on its own assertions: a
                 # Ctrl-C then is served once it is up
                 with signals.shielded():
                     rows_iter = _results_iter(
-                        bank, chunks, plan, how.jobs, how.backend, how.scheduler, stack
+                        bank, chunks, plan, how, summary.total_jobs - summary.done_before, stack
                     )
                 for rows in rows_iter:
                     buffer.extend(rows)
