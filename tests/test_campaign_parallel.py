@@ -60,7 +60,7 @@ def test_a_two_process_dask_local_cluster_gives_the_rows_of_one_worker(
 
 
 def test_a_one_thread_dask_cluster_runs_the_jobs_on_its_worker_a_few_draws_a_task(
-    tmp_path, samples, reference
+    tmp_path, samples, reference, campaign_rows
 ):
     distributed = pytest.importorskip("dask.distributed")
     store = Store(tmp_path / "x.duckdb")
