@@ -13,7 +13,7 @@ trials; "helps" when the whole interval lies below 1.
 Two kinds of time constant are reported. ``tau_vx_s``, ``tau_vy_s``, ``tau_wz_s``: GMR+P's
 own estimates, one per component, fitted on all frequencies together (in-sample). A
 component whose lagged part is small against the map's misfit leaves that fit nearly
-flat in its time constant (vx of the simulated swimmer: 0.2-0.5 s within 10 % of the
+flat in its time constant (vx of the simulated swimmer: 0.2-0.5 s within 12 % of the
 best), so these can be far off. ``tau_s``: the one time constant of the body that best
 predicts each held-out speed (GMR+P with that lag on every component, refitted per held-
 out frequency; the error summed over vx, vy, wz, each relative to GMR's): the value to
