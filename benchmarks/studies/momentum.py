@@ -267,7 +267,7 @@ def tau_profile(db: Path) -> pd.DataFrame:
     `momentum_information` takes: in-sample RMSE (fitted on every frequency) and the
     median over frequencies of the RMSE on each held-out frequency (fitted on the others);
     vx, vy in mm/s, wz in rad/s."""
-    from suds_exp.analysis.momentum_info import _windows
+    from suds_exp.analysis.momentum_info import COMPONENTS, _windows, heldout_errors
     from suds_exp.models import make_model
     from suds_exp.preprocess import get_version
     from suds_exp.store import Store
@@ -276,21 +276,12 @@ def tau_profile(db: Path) -> pd.DataFrame:
     s = get_version(store, "v1").samples()
     freq = store.query_df("SELECT id, frequency_hz FROM trials").set_index("id")["frequency_hz"]
     data = _windows(s.assign(_f=s["trial_id"].map(freq).round(6).to_numpy()), 4, 50, 6)
-    comps = ("vx", "vy", "wz")
-
-    def rmse(pred, test):
-        return [np.sqrt(np.mean((pred[c].to_numpy() - test[c].to_numpy()) ** 2)) for c in comps]
-
+    levels = sorted(data["_f"].unique())
     rows = []
     for tau in (0.0, 0.1, 0.2, 0.25, 0.3, 0.35, 0.4, 0.5, 0.6, 0.8):
-        inside = rmse(make_model("GMR+P", tau=tau).fit(data).predict(data), data)
-        held = np.median(
-            [
-                rmse(make_model("GMR+P", tau=tau).fit(data[data._f != f]).predict(t), t)
-                for f, t in data.groupby("_f")
-            ],
-            axis=0,
-        )
+        pred = make_model("GMR+P", tau=tau).fit(data).predict(data)
+        inside = [np.sqrt(np.mean((pred[c] - data[c]) ** 2)) for c in COMPONENTS]
+        held = heldout_errors(data, levels, tau)
         rows.append(
             {
                 "tau (s)": f"{tau:.2f}",

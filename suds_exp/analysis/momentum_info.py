@@ -127,40 +127,39 @@ def momentum_information(
     return table[list(MOMENTUM_COLUMNS)]
 
 
+def heldout_errors(data: pd.DataFrame, levels, tau: float) -> np.ndarray:
+    """Median over ``levels`` of GMR+P's RMSE on each held-out frequency, (3,) for vx, vy
+    (mm/s) and wz (rad/s): GMR+P with time constant ``tau`` (s) on every component,
+    fitted on the other frequencies of ``data`` (frequency in column ``_f``)."""
+    from suds_exp.models import make_model
+
+    per_fold = []
+    for f in levels:
+        train, test = data[data["_f"] != f], data[data["_f"] == f]
+        if train.empty or test.empty:
+            continue
+        pred = make_model("GMR+P", tau=float(tau)).fit(train).predict(test)
+        per_fold.append(
+            [np.sqrt(np.mean((pred[c].to_numpy() - test[c].to_numpy()) ** 2)) for c in COMPONENTS]
+        )
+    return np.median(per_fold, axis=0)
+
+
 def heldout_tau(data: pd.DataFrame, levels) -> float:
     """The one time constant (s) with which GMR+P best predicts each held-out frequency.
 
     ``data``: samples with their frequency in column ``_f``; ``levels``: the frequencies.
-    For each candidate tau, GMR+P with that lag on vx, vy and wz is fitted on the other
-    frequencies and tested on each one in turn; the score is the sum over the three
-    components of the median held-out RMSE over the frequencies, each relative to GMR's
-    (tau = 0). The best of `TAU_GRID` is refined by a bounded search between its
-    neighbours. 0 when no lag predicts better than GMR.
+    The score of a candidate tau is the sum over vx, vy and wz of `heldout_errors`, each
+    relative to GMR's (tau = 0). The best of `TAU_GRID` is refined by a bounded search
+    between its neighbours. 0 when no lag predicts better than GMR.
     """
     from scipy.optimize import minimize_scalar
 
-    from suds_exp.models import make_model
-
-    folds = [(data[data["_f"] != f], data[data["_f"] == f]) for f in levels]
-    folds = [(train, test) for train, test in folds if len(train) and len(test)]
-
-    def errors(tau: float) -> np.ndarray:
-        per_fold = []
-        for train, test in folds:
-            pred = make_model("GMR+P", tau=float(tau)).fit(train).predict(test)
-            per_fold.append(
-                [
-                    np.sqrt(np.mean((pred[c].to_numpy() - test[c].to_numpy()) ** 2))
-                    for c in COMPONENTS
-                ]
-            )
-        return np.median(per_fold, axis=0)
-
-    base = errors(0.0)
+    base = heldout_errors(data, levels, 0.0)
     base[base <= 0] = 1.0
 
     def score(tau: float) -> float:
-        return float(np.sum(errors(tau) / base))
+        return float(np.sum(heldout_errors(data, levels, tau) / base))
 
     scores = [len(COMPONENTS)] + [score(t) for t in TAU_GRID[1:]]
     i = int(np.argmin(scores))

@@ -68,7 +68,7 @@ from suds_exp.preprocess.body_frame import (
 )
 from suds_exp.preprocess.body_model import JOINT_SHIFT_WARN_MM, BodyModel
 from suds_exp.preprocess.kinematics import Kinematics
-from suds_exp.preprocess.params import params_hash
+from suds_exp.preprocess.params import params_seed
 from suds_exp.robot import MAX_K
 
 #: Most actuated joints a version's samples hold (columns ra_1 .. ra_8, migration 018).
@@ -258,7 +258,7 @@ class SegmentModel(BodyModel):
                 trials = [
                     SegmentFrames(*m.frames[up.child], *m.frames[down.parent]) for m in measured
                 ]
-                seed = int(params_hash(params)[:8], 16)
+                seed = params_seed(params)
                 shifts[seg.name] = noise_shift(trials, fitted, seg.length_mm, seed)
         for j in self.body.joints:
             if self.segments[j.parent].from_joints or self.segments[j.child].from_joints:

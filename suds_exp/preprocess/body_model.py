@@ -24,7 +24,7 @@ from suds_exp.ingest.layout import trial_layout
 from suds_exp.preprocess.body_frame import Joints, SegmentFrames, fit_joints, noise_shift
 from suds_exp.preprocess.chain import chain_settings
 from suds_exp.preprocess.kinematics import Kinematics, kinematics, measure
-from suds_exp.preprocess.params import params_hash
+from suds_exp.preprocess.params import params_seed
 from suds_exp.robot import ROLES
 
 #: `SwimmerModel.joints_warning` speaks when `noise_shift` moves a motor axis further than
@@ -137,7 +137,7 @@ class SwimmerModel(BodyModel):
         joints = fit_joints(pooled, known)
         if params is None:
             return joints
-        seed = int(params_hash(params)[:8], 16)
+        seed = params_seed(params)
         return replace(joints, noise_shift_mm=noise_shift(frames, joints, known, seed))
 
     def joints_warning(self, joints: Joints) -> str | None:

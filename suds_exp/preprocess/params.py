@@ -199,6 +199,12 @@ def params_hash(params: Mapping[str, Any]) -> str:
     return hashlib.sha256(params_json(params).encode()).hexdigest()
 
 
+def params_seed(params: Mapping[str, Any]) -> int:
+    """A seed (0 <= seed < 2**32) derived from a version's parameters, for what its fits
+    draw at random: the same version always draws the same."""
+    return int(params_hash(params)[:8], 16)
+
+
 def actuated_dimension(params: Mapping[str, Any]) -> int:
     """m, the number of r_a columns of a version with these parameters (a segment body's
     description, under ``body``, has one per actuated joint)."""

@@ -409,11 +409,9 @@ def fit(
         joints = {tr.id: shared for tr in items}
     else:
         joints = {tr.id: model.fit_joints([tr.measured], params) for tr in items}
-        poor = [tid for tid, j in joints.items() if model.joints_warning(j)]
+        poor = {tid: w for tid, j in joints.items() if (w := model.joints_warning(j))}
         if poor:
-            warnings.append(
-                f"trials {', '.join(map(str, poor))}: {model.joints_warning(joints[poor[0]])}"
-            )
+            warnings.append(f"trials {', '.join(map(str, poor))}: {next(iter(poor.values()))}")
     for tr in items:
         tr.kin = model.kinematics(tr.measured, joints[tr.id], params, tr.rate_hz, tr.frequency_hz)
     # the passive reducer (PCA, kernel PCA or autoencoder: suds_exp.preprocess.reduction)
