@@ -12,7 +12,14 @@ import pytest
 from typer.testing import CliRunner
 
 from cli import app
-from suds_exp.plan.curve import error_spread, flattening, forecast_doubling, within
+from suds_exp.plan.curve import (
+    Doubling,
+    error_spread,
+    flattening,
+    forecast_doubling,
+    removable_share,
+    within,
+)
 
 runner = CliRunner()
 T, B = 5, 6  # the default target's pairs, the planner's refits
@@ -102,6 +109,68 @@ def test_the_signal_fires_where_a_synthetic_learning_curve_flattens():
         c for c, now, before in zip(cycles[1:], said[1:], said[:-1], strict=True) if now and before
     )
     assert within(fired, curve.flat_from), (fired, curve.flat_from)
+
+
+@pytest.mark.parametrize("floor", [1.0, 4.0, 9.0])
+def test_the_signal_calibrated_by_the_last_doubling_fires_where_a_curve_with_a_floor_flattens(
+    floor,
+):
+    # The real failure: the planner's model expects a doubling to remove its fraction q
+    # of all the target's variance, but part of it is a floor no data remove (the
+    # learner's own error, fit-to-fit scatter). Here the data remove 3/4 of the rest per
+    # doubling (a bias falling as 1/c^2) and the model says 3/4 of everything.
+    cycles = np.arange(5, 405, 10.0)
+    bias, noise, q = 20000.0, 1.0, 0.75
+
+    def variance(c: float) -> np.ndarray:
+        return np.full(T, bias / c**2 + floor + noise)
+
+    def model(c: float, members=None, point=None) -> Doubling:
+        total = variance(c)
+        if members is None:  # the half's forecast: its spread is not read
+            return Doubling(
+                float(np.sqrt(total.mean())), float(np.sqrt((1 - q) * total.mean())), 0.0
+            )
+        return forecast_doubling(members, point, total, q * float(total.sum()), seed=int(c))
+
+    rng = np.random.default_rng(11)
+    error, spread, raw, calibrated = [], [], [], []
+    for c in cycles:
+        total = variance(c)
+        draws = [_draw(rng, noise, total) for _ in range(200)]
+        error.append(float(np.sqrt(total.mean())))
+        spread.append(float(np.sqrt(np.mean([_measured_spread(m) ** 2 for m, _ in draws]))))
+        d = model(c, *draws[0])
+        raw.append(d.stop)
+        d.removable = removable_share(model(c / 2), d.before_mm)
+        calibrated.append(d.stop)
+    curve = flattening(cycles, error, spread)
+    assert curve.flat_from is not None and curve.flat_from > 5 * cycles[0]
+
+    def fired(said):
+        pairs = zip(cycles[1:], said[1:], said[:-1], strict=True)
+        return next((c for c, now, before in pairs if now and before), None)
+
+    # the model alone never sees the floor: its drop stays above the spread
+    assert fired(raw) is None
+    # calibrated by what the last doubling removed, it stops where the curve flattens
+    assert within(fired(calibrated), curve.flat_from), (fired(calibrated), curve.flat_from)
+
+
+def test_the_removable_share_reads_the_doubling_just_recorded():
+    half = Doubling(2.0, 1.0, 0.0)  # the model expected to remove q = 3/4 of 4 mm^2
+    # it removed all it expected: A_h = 4, 1 mm^2 left removable of 1
+    assert removable_share(half, 1.0) == pytest.approx(1.0)
+    # the variance fell by 1.5 of the 3 expected: 2 of the 4 were removable, 0.5 left of 2.5
+    assert removable_share(half, np.sqrt(2.5)) == pytest.approx(0.5 / 2.5)
+    # it did not fall (or rose): all of it is floor, nothing left to remove
+    assert removable_share(half, 2.0) == 0.0 and removable_share(half, 3.0) == 0.0
+    # a half that expected nothing gives nothing to calibrate by
+    assert removable_share(Doubling(2.0, 2.0, 0.0), 1.5) == 1.0
+    d = Doubling(2.0, 1.0, 0.2)
+    assert d.drop_mm == pytest.approx(1.0) and not d.stop
+    d.removable = 0.1
+    assert d.drop_mm == pytest.approx(2.0 - np.sqrt(4 - 0.1 * 3)) and d.stop
 
 
 def _preprocessed(work: Path, gaits: str) -> Path:

@@ -143,7 +143,8 @@ def arm_plan(
     """The loop's curve rows; for the map goal (``truth`` given) each row also has the
     bootstrap spread of the map error (`error_spread`; taken from ``stored``, cycles to
     spread of an earlier run's curves.csv, where it has the count) and the loop's stop
-    signal."""
+    signal, recomputed by the library as it is now up to the count where it first fires
+    (latched, it says stop from there on)."""
     opts = LoopOptions(goal=goal, bound=bound, budget_cycles=budget, seed=seed, cycles=cycles)
     store = Store(work / "plan.duckdb")
     loop = run_loop(store, opts, out=work / "plan")
@@ -168,6 +169,9 @@ def arm_plan(
                 row["error_spread_mm"] = stored[row["cycles"]]
             else:
                 row["error_spread_mm"] = error_spread(part, truth, key, spread_boots)
+            if fired:  # latched: stop for good, whatever a later verdict says
+                row["stop"], row["stop_reason"] = True, "stop (said before)"
+                continue
             # the stopping signal as the library computes it now, from the stored data
             # (the loop's own ensemble seeds), whatever the loop stored when it ran
             fit_seed = derive_seed("plan-fit", loop.name, k)

@@ -48,7 +48,7 @@ import pandas as pd
 from suds_exp.gait.predict import fit_map
 from suds_exp.models.registry import GMR
 from suds_exp.plan.ensemble import MapEnsemble, cycle_blocks
-from suds_exp.plan.recommend import bias_variance, recommend_map
+from suds_exp.plan.recommend import bias_variance, recommend_map, recorded_paths
 from suds_exp.plan.target import Target
 
 N_FOLDS = 4
@@ -228,16 +228,26 @@ def error_spread(
 @dataclass
 class Doubling:
     """The forecast of the next doubling: the expected RMS error (mm per cycle) over the
-    target before and after it, the drop, and the error's bootstrap spread (mm);
-    ``stop`` when the drop is less than the spread."""
+    target before and after it as the planner's variance model says, and the error's
+    bootstrap spread (mm). ``removable`` (0..1) is the share of the variance now that
+    data can remove at all (`removable_share`; 1, the model's own view, when not
+    calibrated): the model's forecast removes its fraction of that share only.
+    ``drop_mm`` is the drop so calibrated; ``stop`` when it is less than the spread."""
 
     before_mm: float
     after_mm: float
     spread_mm: float
+    removable: float = 1.0
+
+    @property
+    def forecast_drop_mm(self) -> float:
+        """The model's drop, uncalibrated (mm)."""
+        return self.before_mm - self.after_mm
 
     @property
     def drop_mm(self) -> float:
-        return self.before_mm - self.after_mm
+        b2, a2 = self.before_mm**2, self.after_mm**2
+        return float(self.before_mm - np.sqrt(max(0.0, b2 - self.removable * (b2 - a2))))
 
     @property
     def stop(self) -> bool:
@@ -251,7 +261,7 @@ def forecast_doubling(
     """The issue's "flattens" test applied to the planner's forecast: the expected error
     is sqrt(V / T) for the total variance V = sum(variance) (mm^2) over the T target
     pairs, after the doubling sqrt((V - removed) / T), against `error_spread` of
-    ``members``, ``point`` and ``variance`` (shapes as there)."""
+    ``members``, ``point`` and ``variance`` (shapes as there). Not calibrated."""
     variance = np.asarray(variance, float)
     total = float(variance.sum())
     removed = min(total, max(0.0, float(removed)))
@@ -260,6 +270,41 @@ def forecast_doubling(
         float(np.sqrt((total - removed) / len(variance))),
         error_spread(members, point, variance, seed),
     )
+
+
+def removable_share(half: Doubling, before_now_mm: float) -> float:
+    """The share (0..1) of the variance now that data can remove, from the doubling just
+    recorded (see the module docstring). ``half``: the model's forecast made on the first
+    half of the cycles (its doubling is the second half); ``before_now_mm``: the model's
+    expected error on all of them (mm).
+
+    Per target pair (mm^2): the model expected to remove the fraction
+    q = 1 - after^2 / before^2 of its variance V_h at half; the variance fell by
+    D = V_h - V_now. If q is right for the part A_h of V_h that data remove and the rest
+    is a floor, A_h = D / q (clipped to [0, V_h]) and A_h (1 - q) is left removable now;
+    the share is that over V_now, clipped to [0, 1]. 1 (no calibration) when the half's
+    forecast removes nothing."""
+    v_half, v_now = half.before_mm**2, before_now_mm**2
+    q = 1.0 - half.after_mm**2 / v_half if v_half > 0 else 0.0
+    if q <= 0 or v_now <= 0:
+        return 1.0
+    a_half = float(np.clip((v_half - v_now) / q, 0.0, v_half))
+    return float(np.clip(a_half * (1.0 - q) / v_now, 0.0, 1.0))
+
+
+def _forecast(samples, ensemble, target, cycles, learner, bias, seed):
+    """The uncalibrated `Doubling` of ``samples`` (see `forecast_signal`), the trials
+    planned for it and the cycle blocks recorded."""
+    pairs = target.pairs()
+    n = len(cycle_blocks(samples))
+    trials = max(1, round(n / cycles))
+    if bias is None:
+        bias = bias_variance(samples, target, learner, ensemble.point)
+    members, point = ensemble.displacements(pairs)
+    noise = members.var(axis=0, ddof=1).sum(axis=1) if len(members) > 1 else np.zeros(len(pairs))
+    recs = recommend_map(ensemble, target, cycles, trials, samples, learner, bias)
+    d = forecast_doubling(members, point, noise + bias, sum(r.score for r in recs), seed)
+    return d, recs, n
 
 
 def forecast_signal(
@@ -274,25 +319,37 @@ def forecast_signal(
     """The map goal's stopping signal (see the module docstring): the expected drop (mm
     per cycle) of the target's RMS prediction error over the next doubling of the
     recorded cycles, spent on the trials of ``cycles`` cycles `recommend_map` would
-    choose, against the bootstrap spread (mm) of that error (`forecast_doubling`).
+    choose, calibrated by what the last doubling removed, against the bootstrap spread
+    (mm) of that error.
 
     The variance per target pair is ``ensemble``'s bootstrap variance plus the
     path-jackknife bias (``bias`` when the caller has it); the trials remove what their
-    scores say. ``change_mm`` is the drop, ``spread_mm`` the spread, ``cycles`` [now,
-    after the doubling]; ``seed`` seeds the spread's draws."""
-    pairs = target.pairs()
-    n = len(cycle_blocks(samples))
-    trials = max(1, round(n / cycles))
-    if bias is None:
-        bias = bias_variance(samples, target, learner, ensemble.point)
-    members, point = ensemble.displacements(pairs)
-    noise = members.var(axis=0, ddof=1).sum(axis=1) if len(members) > 1 else np.zeros(len(pairs))
-    recs = recommend_map(ensemble, target, cycles, trials, samples, learner, bias)
-    d = forecast_doubling(members, point, noise + bias, sum(r.score for r in recs), seed)
+    scores say (`forecast_doubling`). The same forecast made on the first half of the
+    cycle blocks (recording order; its own ``len(ensemble.members)`` refits) gives the
+    share of the variance now that data can remove (`removable_share`), which the
+    drop is calibrated by; uncalibrated while the half holds fewer than two recorded
+    paths.
+    ``change_mm`` is the calibrated drop, ``spread_mm`` the spread, ``cycles`` [now,
+    after the doubling]; ``seed`` seeds the spread's draws and the half's refits."""
+    d, recs, n = _forecast(samples, ensemble, target, cycles, learner, bias, seed)
+    half_note = ""
+    blocks = cycle_blocks(samples)
+    half = pd.concat(blocks[: len(blocks) // 2], ignore_index=True) if len(blocks) > 1 else None
+    # with one path the model's error is its prior (the motion itself), not a measurement:
+    # nothing to calibrate by
+    if half is not None and len(recorded_paths(half)) >= 2:
+        half_ens = MapEnsemble.fit(half, learner, len(ensemble.members), seed + 1)
+        h, _, m = _forecast(half, half_ens, target, cycles, learner, None, seed + 1)
+        d.removable = removable_share(h, d.before_mm)
+        half_note = (
+            f"; the planner's model says {d.forecast_drop_mm:.2f}, but the last doubling "
+            f"({m} -> {n} cycles) lowered it from {h.before_mm:.2f} where the model expected "
+            f"{h.after_mm:.2f}, so {100 * d.removable:.0f} % of the error now is removable"
+        )
     doubling = (
         f"the next doubling of cycles ({n} -> {n + len(recs) * cycles}, the {len(recs)} "
         f"trials planned) is expected to lower the target's prediction error by "
-        f"{d.drop_mm:.2f} mm per cycle ({d.before_mm:.2f} -> {d.after_mm:.2f})"
+        f"{d.drop_mm:.2f} mm per cycle ({d.before_mm:.2f} now{half_note})"
     )
     if d.stop:
         message = (
