@@ -26,6 +26,30 @@ is simulated). The latched signal aims at the count from which the curve stays f
 (`Flattening.flat_from`), not at the first count the definition holds at (at one
 trial the error's spread is wide enough to call almost any drop flat).
 
+Why the forecast is calibrated, and how. The variance model counts all of the
+target's variance as removable: a new path removes its share of the bias, more cycles
+their share of the noise. Part of it no data of this kind remove: the learner's own
+error where it has data, and the scatter from one fit to the next. Uncalibrated, the
+forecast drop stays above the error's spread long after the measured error stops
+falling (twice too late on the simulator's map loops, docs/results/adaptive.md). The
+data's own history says how much is removable: the same forecast
+made on the first half of the cycles (recording order) expected to remove the fraction
+q of the variance V_h it saw, and the model on all the cycles sees V_now. If q is the
+right rate for the removable part A_h and the rest is a floor, the fall V_h - V_now is
+q A_h, so A_h = (V_h - V_now) / q and A_h (1 - q) is still removable now; the forecast
+removes its fraction of that share of V_now only (`removable_share`). No constant is
+fitted: a variance that did not fall over the last doubling leaves nothing removable,
+one that fell as the model said leaves the model's forecast as it was. While the first
+half holds a single recorded path the model's error there is its prior (the motion
+itself), not a measurement, and the forecast is not calibrated.
+
+Why not an empirical learning curve of held-out error (leave a recorded path out,
+predict its measured motion, at nested training sizes, fit a n^-b + c): on the map
+loops the held-out paths are the extremes of what is recorded (D+, S+), whose error is
+an extrapolation (10 mm against about 2 on the interpolated target) and moves up or
+down by millimetres as one more trial arrives, so its slope says nothing about the
+target's.
+
 `target_signal` judges the last doubling on the target instead: the
 map fitted on the first half of the recorded cycles and the map fitted on all of them
 predict the target's net displacement per cycle; if the last doubling moved those
