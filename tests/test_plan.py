@@ -380,6 +380,10 @@ def test_the_map_stopping_signal_forecasts_the_next_doubling(small, three_paths)
     one, three = verdicts["one path"], verdicts["three paths"]
     assert not one.stop, one.message
     assert three.change_mm < one.change_mm
+    # calibrated by the last doubling once its first half holds two paths (O, D-), not
+    # on one path, whose model error is a prior
+    assert "of its variance now is removable" in three.message
+    assert "removable" not in one.message
 
 
 def test_a_loop_from_an_empty_database_knows_the_robots_motor_axis_distance(gait_loop):

@@ -368,7 +368,7 @@ def forecast_signal(
         half_note = (
             f"; the planner's model says {d.forecast_drop_mm:.2f}, but the last doubling "
             f"({m} -> {n} cycles) lowered it from {h.before_mm:.2f} where the model expected "
-            f"{h.after_mm:.2f}, so {100 * d.removable:.0f} % of the error now is removable"
+            f"{h.after_mm:.2f}, so {100 * d.removable:.0f} % of its variance now is removable"
         )
     doubling = (
         f"the next doubling of cycles ({n} -> {n + len(recs) * cycles}, the {len(recs)} "
