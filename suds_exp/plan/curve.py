@@ -367,8 +367,9 @@ def forecast_signal(
         d.removable = removable_share(h, d.before_mm)
         half_note = (
             f"; the planner's model says {d.forecast_drop_mm:.2f}, but the last doubling "
-            f"({m} -> {n} cycles) lowered it from {h.before_mm:.2f} where the model expected "
-            f"{h.after_mm:.2f}, so {100 * d.removable:.0f} % of its variance now is removable"
+            f"({m} -> {n} cycles) took it from {h.before_mm:.2f} to {d.before_mm:.2f} where "
+            f"the model expected {h.after_mm:.2f}, so {100 * d.removable:.0f} % of its "
+            "variance now is removable"
         )
     doubling = (
         f"the next doubling of cycles ({n} -> {n + len(recs) * cycles}, the {len(recs)} "
