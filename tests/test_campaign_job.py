@@ -212,3 +212,20 @@ def test_a_preloaded_dask_worker_runs_no_profiler_and_wakes_its_loop_less():
     [(profiles, quiet)] = ran[True]
     assert not profiles and quiet.keys() == default.keys()
     assert all(quiet[name] >= 1000 for name in quiet), quiet
+
+
+def test_a_chunk_runs_blas_on_one_thread_and_gives_the_pools_back(bank, monkeypatch):
+    """``blas="block"`` (a dask task): every BLAS and OpenMP pool at one thread while the
+    chunk's draws run, as the caller had them after, call after call."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    def threads() -> list[int]:
+        return [pool["num_threads"] for pool in threadpool_info()]
+
+    seen = []
+    monkeypatch.setattr(job, "run_draw", lambda *args: seen.append(set(threads())) or [])
+    with threadpool_limits(limits=2):
+        for _ in range(3):
+            assert job.run_chunk(bank, [(None, ["TLS"])], {}, 1, blas="block") == []
+            assert set(threads()) == {2}
+    assert seen == [{1}] * 3
