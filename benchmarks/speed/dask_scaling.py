@@ -28,6 +28,8 @@ predict_seconds`` as the results table stores it; "client CPU" is the ``suds-exp
 process's CPU time (user + system, its start-up included: imports, samples, plan; ~3 s on
 a 2-core machine) and its share of the CPU time of the client, the scheduler and the
 workers together during the run (read from ``/proc``, so dask rows only, on Linux);
+"all CPU" is the CPU time of the run's processes together (the client and its loky
+workers; with dask, the client, the scheduler and the workers);
 "tasks" is the number of campaign tasks the cluster ran and "task s" their median compute
 time (the scheduler's task stream; a task is a batch of draws, see ``run_campaign``'s
 ``chunk_jobs``). ``--quick``: phase-only, one draw of 2 cycles, one dask worker (a smoke
@@ -225,6 +227,7 @@ def _run(
         "digest": digest,
         "client_cpu": client,
         "share": client / (client + cluster_cpu) if cluster else float("nan"),
+        "all_cpu": client + cluster_cpu,
         "tasks": len(tasks),
         "task_s": median(tasks) if tasks else float("nan"),
     }
@@ -280,13 +283,14 @@ def main(argv=None) -> int:
     )
     print(
         f"{'mode':22} {'wall s':>6} {'speed-up':>8} {'proc s':>6} {'speed-up':>8} "
-        f"{'job ms':>6} {'job/in-proc':>11} {'client CPU s':>12} {'share':>6} "
+        f"{'job ms':>6} {'job/in-proc':>11} {'client CPU s':>12} {'share':>6} {'all CPU s':>9} "
         f"{'tasks':>5} {'task s':>6}  rows"
     )
     for label, rs in runs.items():
         wall, job = median(r["wall"] for r in rs), median(r["job_ms"] for r in rs)
         process = median(r["process"] for r in rs)
         client, share = median(r["client_cpu"] for r in rs), median(r["share"] for r in rs)
+        all_cpu = median(r["all_cpu"] for r in rs)
         share_text = f"{share:6.1%}" if share == share else f"{'':6}"
         tasks, task_s = median(r["tasks"] for r in rs), median(r["task_s"] for r in rs)
         task_text = f"{tasks:5.0f} {task_s:6.2f}" if tasks else f"{'':5} {'':6}"
@@ -294,7 +298,7 @@ def main(argv=None) -> int:
         print(
             f"{label:22} {wall:6.1f} {ref_wall / wall:7.2f}x {process:6.1f} "
             f"{ref_process / process:7.2f}x {job:6.1f} {job / ref_job:10.2f}x "
-            f"{client:12.2f} {share_text} {task_text}  {same}"
+            f"{client:12.2f} {share_text} {all_cpu:9.2f} {task_text}  {same}"
         )
     if a.rounds > 1:
         print("each round's speed-up (wall), in order:")
