@@ -6,7 +6,8 @@ through joblib, or the threads of a dask.distributed cluster, a few tasks a thre
 Finished rows come back to the parent, which writes them in batches, each batch in one
 transaction, holding the database file only while it writes, so `suds-exp status`,
 `suds-exp sql` and `duckdb -readonly` can read in between. A file lock beside the
-database keeps a second run out.
+database keeps a second run out. The chunks are run and their rows written by
+`suds_exp.campaign.execute`; the dask side is `suds_exp.campaign.cluster`.
 
 Stopping: Ctrl-C (or SIGTERM) stops after writing every row already received; a signal
 that arrives while a batch is being written is served after the write, so a batch is
