@@ -175,13 +175,22 @@ def test_a_worker_with_the_nannys_trim_threshold_stops_faulting_its_arrays_in(tm
             assert int(fixed) < 1_000, out.stdout
 
 
-def _profiles(dask_worker) -> bool:
-    return "profile" in dask_worker.periodic_callbacks
+def _chores(dask_worker) -> tuple:
+    """Whether the worker samples its task thread's stack, and how often (ms) its event
+    loop wakes for its tick, its system monitor and its memory monitor."""
+    every = {
+        name: dask_worker.periodic_callbacks[name].callback_time
+        for name in ("tick", "monitor", "memory_monitor")
+        if name in dask_worker.periodic_callbacks
+    }
+    return "profile" in dask_worker.periodic_callbacks, every
 
 
-def test_a_preloaded_dask_worker_runs_no_statistical_profiler():
+def test_a_preloaded_dask_worker_runs_no_profiler_and_wakes_its_loop_less():
     """Workers started with the preload (as the local cluster and the how-to start them)
-    do not sample their task thread's stack; others do (the check can fail)."""
+    do not sample their task thread's stack, and their event loop wakes at most once a
+    second for its chores (dask: every 20, 100 and 500 ms); others keep dask's defaults
+    (the check can fail)."""
     pytest.importorskip("distributed")
     from dask.distributed import Client, LocalCluster
 
@@ -197,5 +206,26 @@ def test_a_preloaded_dask_worker_runs_no_statistical_profiler():
             ) as cluster,
             Client(cluster) as client,
         ):
-            ran[bool(preload)] = list(client.run(_profiles).values())
-    assert ran == {False: [True], True: [False]}
+            ran[bool(preload)] = list(client.run(_chores).values())
+    [(profiles, default)] = ran[False]
+    assert profiles and default == {"tick": 20, "monitor": 500, "memory_monitor": 100}
+    [(profiles, quiet)] = ran[True]
+    assert not profiles and quiet.keys() == default.keys()
+    assert all(quiet[name] >= 1000 for name in quiet), quiet
+
+
+def test_a_chunk_runs_blas_on_one_thread_and_gives_the_pools_back(bank, monkeypatch):
+    """``blas="block"`` (a dask task): every BLAS and OpenMP pool at one thread while the
+    chunk's draws run, as the caller had them after, call after call."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    def threads() -> list[int]:
+        return [pool["num_threads"] for pool in threadpool_info()]
+
+    seen = []
+    monkeypatch.setattr(job, "run_draw", lambda *args: seen.append(set(threads())) or [])
+    with threadpool_limits(limits=2):
+        for _ in range(3):
+            assert job.run_chunk(bank, [(None, ["TLS"])], {}, 1, blas="block") == []
+            assert set(threads()) == {2}
+    assert seen == [{1}] * 3

@@ -87,3 +87,17 @@ def test_a_one_thread_dask_cluster_runs_the_jobs_on_its_worker_a_few_draws_a_tas
     tasks = [t for t in stream.data if t["key"].startswith("run_chunk")]
     assert 1 < len(tasks) < N_JOBS // len(OPTIONS["models"])
     assert {t["worker"] for t in tasks} == workers
+
+
+def test_dask_tasks_hold_a_second_of_jobs_and_shrink_to_a_draw_at_the_end():
+    """Tasks of ~1 s at the job time seen so far (few tasks: each costs the scheduler and
+    the client milliseconds), the last ones a draw each (the workers finish together)."""
+    from suds_exp.campaign.cluster import TaskSizer, regroup
+
+    draws = [[((k,), ["a"] * 5)] for k in range(400)]  # 400 draws of 5 jobs
+    sizer = TaskSizer(2000, threads=2)
+    sizer.seen([{"fit_seconds": 0.008, "predict_seconds": 0.002}] * 10)  # 10 ms a job
+    sizes = [sum(len(names) for _, names in task) for task in regroup(iter(draws), sizer)]
+    assert sum(sizes) == 2000
+    assert sizes[0] == 100 and sizes[-4:] == [5] * 4
+    assert sizes == sorted(sizes, reverse=True) and len(sizes) < 40

@@ -7,8 +7,8 @@ Usage::
 
     .venv/bin/python -m benchmarks.speed.dask_scaling                  # a small dataset
     .venv/bin/python -m benchmarks.speed.dask_scaling --boots 15 --rounds 2    # ~2 min idle
-    .venv/bin/python -m benchmarks.speed.dask_scaling \
-        --worker-env DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False
+    .venv/bin/python -m benchmarks.speed.dask_scaling --boots 60 --rounds 3 --workers 2
+    .venv/bin/python -m benchmarks.speed.dask_scaling --worker-env OMP_NUM_THREADS=1
 
 The dataset (4 conditions, 2 repeats of 10 cycles, simulated once into a temporary
 folder, or ``--db``, a preprocessed database) is copied for every run. Each round runs,
@@ -18,11 +18,18 @@ in turn: ``suds-exp run`` in-process (``-j 1``), with loky (``-j 2``), and with
 suds_exp.campaign.dask_worker`` processes, 1 and 2 of them by default; ``--nanny`` keeps
 dask's nanny process), stopped after each run.
 ``--worker-env`` sets environment variables of the dask workers only (to test what slows
-them down). Figures are medians over ``--rounds``; "job" is a job's ``fit_seconds +
+them down). Figures are medians over ``--rounds`` (with more than one, each round's
+speed-up is printed too); "wall" is the run's own time as ``run`` reports it (from the
+campaign's start: the database opened, the samples loaded, the plan, the cluster joined,
+the jobs, the last write), "proc" the ``suds-exp run`` process's wall time, its start-up
+(Python, imports, options) included, each with its speed-up over in-process; "job" is a
+job's ``fit_seconds +
 predict_seconds`` as the results table stores it; "client CPU" is the ``suds-exp run``
 process's CPU time (user + system, its start-up included: imports, samples, plan; ~3 s on
 a 2-core machine) and its share of the CPU time of the client, the scheduler and the
 workers together during the run (read from ``/proc``, so dask rows only, on Linux);
+"all CPU" is the CPU time of the run's processes together (the client and its loky
+workers; with dask, the client, the scheduler and the workers);
 "tasks" is the number of campaign tasks the cluster ran and "task s" their median compute
 time (the scheduler's task stream; a task is a batch of draws, see ``run_campaign``'s
 ``chunk_jobs``). ``--quick``: phase-only, one draw of 2 cycles, one dask worker (a smoke
@@ -41,6 +48,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 from statistics import median
 
@@ -50,10 +58,16 @@ BIN = Path(sys.executable).parent
 
 
 def _suds(*args: str) -> str:
+    return _timed_suds(*args)[0]
+
+
+def _timed_suds(*args: str) -> tuple[str, float]:
+    """The output of ``suds-exp ARGS`` and the process's wall time, its start-up included."""
+    t0 = time.perf_counter()
     out = subprocess.run([str(BIN / "suds-exp"), *args], capture_output=True, text=True)
     if out.returncode:
         raise SystemExit(f"suds-exp {' '.join(args)}: {out.stderr.strip()}")
-    return out.stdout
+    return out.stdout, time.perf_counter() - t0
 
 
 def _dataset(folder: Path) -> Path:
@@ -191,7 +205,8 @@ def _run(
         "-q",
         *extra,
     ]
-    summary = json.loads(_suds(*args))
+    out, process = _timed_suds(*args)
+    summary = json.loads(out)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     # the run's process and, with loky, its workers (reaped by it)
     client = (after.ru_utime + after.ru_stime) - (children.ru_utime + children.ru_stime)
@@ -206,11 +221,13 @@ def _run(
     digest = hashlib.sha256(rows.to_csv(index=False).encode()).hexdigest()[:12]
     return {
         "wall": summary["seconds"],
+        "process": process,
         "job_ms": 1000 * job,
         "jobs": summary["total_jobs"],
         "digest": digest,
         "client_cpu": client,
         "share": client / (client + cluster_cpu) if cluster else float("nan"),
+        "all_cpu": client + cluster_cpu,
         "tasks": len(tasks),
         "task_s": median(tasks) if tasks else float("nan"),
     }
@@ -230,6 +247,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     if a.quick:
         a.models, a.boots, a.train_cycles, a.workers, a.rounds = "phase-only", 1, 2, "1", 1
+    began, load = time.perf_counter(), os.getloadavg()
     env = dict(item.split("=", 1) for item in a.worker_env)
     counts = [int(n) for n in a.workers.split(",")]
     with tempfile.TemporaryDirectory(prefix="suds-dask-") as tmp:
@@ -255,26 +273,38 @@ def main(argv=None) -> int:
                 runs.setdefault(f"dask TCP, {n} worker(s)", []).append(r)
     ref = runs["in-process"]
     ref_wall, ref_job = median(r["wall"] for r in ref), median(r["job_ms"] for r in ref)
+    ref_process = median(r["process"] for r in ref)
     print(
         f"{ref[0]['jobs']} jobs ({a.models}; {a.boots} draws, {a.train_cycles} cycles), "
         f"{a.rounds} round(s), medians; worker env {env or 'default'}; "
-        f"{'with' if a.nanny else 'no'} nanny"
+        f"{'with' if a.nanny else 'no'} nanny; load average at the start "
+        f"{load[0]:.1f}, at the end {os.getloadavg()[0]:.1f}; "
+        f"{time.perf_counter() - began:.0f} s in all"
     )
     print(
-        f"{'mode':26} {'wall s':>7} {'speed-up':>8} {'job ms':>7} {'job/in-proc':>11} "
-        f"{'client CPU s':>12} {'share':>6} {'tasks':>5} {'task s':>6}  rows"
+        f"{'mode':22} {'wall s':>6} {'speed-up':>8} {'proc s':>6} {'speed-up':>8} "
+        f"{'job ms':>6} {'job/in-proc':>11} {'client CPU s':>12} {'share':>6} {'all CPU s':>9} "
+        f"{'tasks':>5} {'task s':>6}  rows"
     )
     for label, rs in runs.items():
         wall, job = median(r["wall"] for r in rs), median(r["job_ms"] for r in rs)
+        process = median(r["process"] for r in rs)
         client, share = median(r["client_cpu"] for r in rs), median(r["share"] for r in rs)
+        all_cpu = median(r["all_cpu"] for r in rs)
         share_text = f"{share:6.1%}" if share == share else f"{'':6}"
         tasks, task_s = median(r["tasks"] for r in rs), median(r["task_s"] for r in rs)
         task_text = f"{tasks:5.0f} {task_s:6.2f}" if tasks else f"{'':5} {'':6}"
         same = "same" if {r["digest"] for r in rs} == {ref[0]["digest"]} else "DIFFER"
         print(
-            f"{label:26} {wall:7.1f} {ref_wall / wall:7.2f}x {job:7.1f} {job / ref_job:10.2f}x "
-            f"{client:12.2f} {share_text} {task_text}  {same}"
+            f"{label:22} {wall:6.1f} {ref_wall / wall:7.2f}x {process:6.1f} "
+            f"{ref_process / process:7.2f}x {job:6.1f} {job / ref_job:10.2f}x "
+            f"{client:12.2f} {share_text} {all_cpu:9.2f} {task_text}  {same}"
         )
+    if a.rounds > 1:
+        print("each round's speed-up (wall), in order:")
+        for label, rs in runs.items():
+            ups = " ".join(f"{r0['wall'] / r['wall']:.2f}x" for r0, r in zip(ref, rs, strict=True))
+            print(f"  {label:20} {ups}")
     return 0
 
 

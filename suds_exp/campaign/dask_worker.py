@@ -16,7 +16,15 @@ It also turns off the worker's statistical profiler (``distributed.worker.profil
 look at the task thread's stack every 10 ms, for the dashboard's profile page): on a
 2-worker cluster of 1,200 five-cycle jobs it took 7 % of the workers' CPU time (8.9-9.6 s
 against 9.5-10.2 s a worker, two rounds each, measured under load). The module is
-imported before the worker sets its periodic callbacks up, so the setting takes effect.
+imported before the worker sets its profiler up, so the setting takes effect.
+
+And it wakes the worker's event loop less often for its chores (`QUIET_LOOP`): the
+tick that watches the loop's health (every 20 ms by default), the system monitor that
+feeds the dashboard's graphs (500 ms) and the memory monitor (100 ms). Each wake-up takes
+the GIL from the task thread and a core from the other workers; on a 2-worker cluster
+of 1,200 five-cycle jobs the loop's own CPU time fell from 0.39-0.40 s to 0.12-0.15 s a
+worker (4 % of a worker's CPU time to 1.3 %; measured under load). The memory limits
+still hold, checked every second.
 """
 
 from __future__ import annotations
@@ -24,9 +32,18 @@ from __future__ import annotations
 import signal
 import threading
 
+#: How often (ms) a worker's event loop wakes for each chore: the name of its periodic
+#: callback and of the dask setting it starts from.
+QUIET_LOOP = {
+    "tick": ("distributed.admin.tick.interval", 1000),
+    "monitor": ("distributed.admin.system-monitor.interval", 5000),
+    "memory_monitor": ("distributed.worker.memory.monitor-interval", 1000),
+}
+
 
 def dask_setup(worker) -> None:
-    """Called by dask in each worker process as it starts."""
+    """Called by dask in each worker process as it starts (``worker``: the dask Worker;
+    None when this module is imported)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     from suds_exp.campaign.job import settle_allocator
@@ -34,13 +51,20 @@ def dask_setup(worker) -> None:
     settle_allocator()
     import suds_exp.models  # noqa: F401  (warm: see the module's docstring)
 
+    # the tick and the system monitor were set up before the preload was imported
+    callbacks = getattr(worker, "periodic_callbacks", {})
+    for name, (_, ms) in QUIET_LOOP.items():
+        if name in callbacks:
+            callbacks[name].callback_time = ms
 
-def _quiet_profiler() -> None:
+
+def _quiet() -> None:
     import dask
 
     dask.config.set({"distributed.worker.profile.enabled": False})
+    dask.config.set({key: f"{ms}ms" for key, ms in QUIET_LOOP.values()})
 
 
 # importing happens before dask_setup, as early as a worker can act
-_quiet_profiler()
+_quiet()
 dask_setup(None)

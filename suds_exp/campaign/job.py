@@ -11,13 +11,14 @@ import contextlib
 import json
 import os
 import signal
+import sys
 import threading
 import time
 from datetime import UTC, datetime
 
 import numpy as np
 import pandas as pd
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController, threadpool_limits
 
 from suds_exp.campaign.bank import SampleBank
 from suds_exp.campaign.grid import KEY_COLUMNS, Draw
@@ -60,8 +61,8 @@ def run_chunk(
 
     BLAS runs on one thread, so a job computes the same floating-point numbers in the
     parent, in a loky worker and on a dask worker, and workers do not oversubscribe the
-    cores. ``blas``: "block" limits it for this call (~2 ms: threadpoolctl scans the loaded
-    libraries), "pin" once for the life of the process (dedicated loky workers), "none"
+    cores. ``blas``: "block" limits it for this call (`one_blas_thread`), "pin" once for
+    the life of the process (dedicated loky workers), "none"
     leaves it to the caller. ``parent``: in a worker process, the pid of the process that
     runs the campaign; the worker then ends itself when that process is gone
     (`watch_parent`) and leaves Ctrl-C to it.
@@ -75,10 +76,27 @@ def run_chunk(
     if blas == "pin" and not _PINNED:
         threadpool_limits(limits=1)
         _PINNED = True
-    with threadpool_limits(limits=1) if blas == "block" else contextlib.nullcontext():
+    with one_blas_thread() if blas == "block" else contextlib.nullcontext():
         for draw, names in chunk:
             rows.extend(run_draw(bank, draw, names, models, test_cycles))
     return rows
+
+
+_POOLS: tuple[int, ThreadpoolController] | None = None
+
+
+def one_blas_thread():
+    """A context manager: every BLAS and OpenMP pool of this process at one thread inside,
+    as they were after.
+
+    threadpoolctl finds the pools by scanning the loaded libraries, 2-5 ms of CPU a time
+    (measured under load), as much as 7 % of a task of one draw on a dask worker; the
+    scan is kept until a module is imported (how a new library gets loaded here), so a
+    worker scans once rather than once a task."""
+    global _POOLS
+    if _POOLS is None or _POOLS[0] != len(sys.modules):
+        _POOLS = (len(sys.modules), ThreadpoolController())
+    return _POOLS[1].limit(limits=1)
 
 
 #: glibc's mallopt parameters, and the thresholds `settle_allocator` sets, in bytes.
