@@ -446,13 +446,14 @@ def ratios(arms: dict, budget: int, peer_budget: int) -> dict:
 
 def print_gait_table(summary: dict) -> None:
     """Cycles to 80 % / 90 % of the ceiling: median [least-most] over runs, per arm and
-    dataset seed (> means some run, or the median one, never reached it)."""
+    dataset seed ("missed": the median run never reached it within the arm's budget)."""
 
     def cell(st: dict) -> str:
-        med = "-" if st["median"] is None else f"{st['median']:g}"
-        low = "-" if st["min"] is None else st["min"]
+        if st["min"] is None:
+            return "never"
+        med = "missed" if st["median"] is None else f"{st['median']:g}"
         high = "never" if st["max"] is None else st["max"]
-        return f"{med} [{low}-{high}]" + (f" ({st['missed']} missed)" if st["missed"] else "")
+        return f"{med} [{st['min']}-{high}]" + (f" ({st['missed']} missed)" if st["missed"] else "")
 
     for arm, per_seed in summary["arms"].items():
         for seed, e in per_seed.items():
