@@ -492,7 +492,7 @@ def main(argv=None) -> None:
     ap.add_argument("--cycles", type=int, default=5, help="cycles per planned/random/BO trial")
     ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
     ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
-    ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms ('' for none)")
+    ap.add_argument("--arms", default="grid,random,plan,bo,tpe", help="gait-goal arms ('' none)")
     ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
     ap.add_argument(
         "--repeats", type=int, default=3,
