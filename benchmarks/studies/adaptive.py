@@ -11,8 +11,9 @@ recorded cycles (warm-up included), five ways of spending robot time:
 - ``plan``: `suds-exp plan loop` (`suds_exp.plan.run_loop`), from 5 cycles of O at 1/2 Hz;
 - ``bo``: Bayesian optimisation (`bayesian-optimization`, default settings, 8 random
   starts) of the same Fourier gait's 10 coefficients, each evaluation one trial of
-  `--cycles` cycles whose forward displacement per cycle is measured on the trial itself
-  (actuator noise included, cycles after the first averaged); no map;
+  `--cycles` cycles (within --bo-budget) whose forward displacement per cycle is measured
+  on the trial itself (actuator noise included, cycles after the first averaged); no map;
+- ``tpe``: the same with `optuna`'s tree-structured Parzen estimator (default settings);
 - ``designer`` (with --designer): `gait design --iterations 5 --verify` from the full grid
   (also GMR's error on the unseen gaits learned from the full grid, the map goal's bar).
 
@@ -25,6 +26,13 @@ GMR's error on the fixed unseen gaits of `suds_exp.plan.unseen_gaits` (RMS dista
 predicted from simulated net displacement per cycle, mm) for grid, random and the
 plan loop with --goal map.
 
+Each dataset seed's gait-goal arms are run several times (--repeats for plan and random,
+--peer-repeats for bo and tpe; grid and designer have no randomness of their own): run r's
+seed is the dataset seed for r = 0 and derived from (arm, dataset seed, r) after, and
+drives all of the run's randomness. The summary gives each arm's cycles to 80 % and 90 %
+of the ceiling as median and range over the runs, and the plan loop's median over each
+peer's (`ratios`; the bar is <= 1/3).
+
 Run: .venv/bin/python -m benchmarks.studies.adaptive --seeds 0,1,2 --budget 50 --bo-budget 150
          [--map-budget 390 --map-arms plan,fullgrid] [--designer] [--out reports/adaptive]
 
@@ -33,7 +41,7 @@ flattens (the next doubling of cycles lowers the error by less than its bootstra
 spread, GMR refitted on cycle-block resamples) and whether the loop's stopping signal
 first fired within 20 % of that count (`flattening`, in summary.json).
 Writes curves.csv, summary.json and the figures gait.png (and map.png) to --out.
-(`pip install -e '.[bench]'` installs bayesian-optimization.)
+(`pip install -e '.[bench]'` installs bayesian-optimization and optuna.)
 """
 
 from __future__ import annotations
@@ -225,33 +233,67 @@ def measured_forward(gait, cycles: int, seed: int, config: SimConfig) -> float:
     return cycle_motion(poses, per, range(1, cycles)).forward_mm
 
 
+class DirectTrials:
+    """The objective of a black-box peer: each evaluation records one trial of ``cycles``
+    cycles of a Fourier gait (the 10 coefficients of ``x``, projected into the bound) and
+    returns its measured forward displacement per cycle; the curve's rows follow the best
+    evaluation so far, scored with the gait followed exactly."""
+
+    def __init__(self, arm: str, seed: int, cycles: int, bound: float):
+        self.arm, self.seed, self.cycles, self.bound = arm, seed, cycles, bound
+        self.config, self.n, self.best, self.rows = SimConfig(), 0, -np.inf, []
+        self.achieved = np.nan
+
+    def __call__(self, x: np.ndarray) -> float:
+        self.n += 1
+        gait = within_bound(FourierGait.from_vector(x, f"{self.arm}-{self.n}"), self.bound)
+        noise = derive_seed(self.arm, self.seed, self.n)
+        value = measured_forward(gait, self.cycles, noise, self.config)
+        if value > self.best:
+            self.best = value
+            self.achieved = float(simulate_forward([gait], FREQ)[0])
+        self.rows.append({"cycles": self.n * self.cycles, "best_forward_mm": self.achieved})
+        return value
+
+
+def coefficient_bounds(bound: float) -> list[tuple[float, float]]:
+    """The box the peers search (rad): centre within +/- 0.3, harmonics within the bound."""
+    return [(-0.3, 0.3) if i < 2 else (-bound, bound) for i in range(2 + 4 * ORDER)]
+
+
 def arm_bo(seed: int, budget: int, cycles: int, bound: float) -> list[dict]:
+    """GP Bayesian optimisation (`bayesian-optimization`, default settings, 8 random
+    starts); ``seed`` is its random state and its trials' noise stream."""
     from bayes_opt import BayesianOptimization
 
-    config = SimConfig()
-    keys = [f"x{i}" for i in range(2 + 4 * ORDER)]
-    pbounds = {k: ((-0.3, 0.3) if i < 2 else (-bound, bound)) for i, k in enumerate(keys)}
+    trials = DirectTrials("bo", seed, cycles, bound)
+    box = coefficient_bounds(bound)
+    pbounds = {f"x{i}": b for i, b in enumerate(box)}
     n_evals = budget // cycles
-    state = {"n": 0, "best": -np.inf, "gait": None}
-    rows = []
-    achieved: dict[int, float] = {}
 
     def objective(**kw):
-        state["n"] += 1
-        x = np.array([kw[k] for k in keys])
-        gait = within_bound(FourierGait.from_vector(x, f"bo-{state['n']}"), bound)
-        value = measured_forward(gait, cycles, derive_seed("bo", seed, state["n"]), config)
-        if value > state["best"]:
-            state["best"], state["gait"] = value, gait
-        key = id(state["gait"])
-        if key not in achieved:
-            achieved[key] = float(simulate_forward([state["gait"]], FREQ)[0])
-        rows.append({"cycles": state["n"] * cycles, "best_forward_mm": achieved[key]})
-        return value
+        return trials(np.array([kw[f"x{i}"] for i in range(len(box))]))
 
     opt = BayesianOptimization(objective, pbounds, random_state=seed, verbose=0)
     opt.maximize(init_points=min(8, n_evals), n_iter=max(0, n_evals - 8))
-    return rows
+    return trials.rows
+
+
+def arm_tpe(seed: int, budget: int, cycles: int, bound: float) -> list[dict]:
+    """Tree-structured Parzen estimator (`optuna`'s TPESampler, default settings: 10
+    random starts); ``seed`` is its sampler's seed and its trials' noise stream."""
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    trials = DirectTrials("tpe", seed, cycles, bound)
+    box = coefficient_bounds(bound)
+
+    def objective(trial):
+        return trials(np.array([trial.suggest_float(f"x{i}", *b) for i, b in enumerate(box)]))
+
+    study = optuna.create_study(direction="maximize", sampler=optuna.samplers.TPESampler(seed=seed))
+    study.optimize(objective, n_trials=budget // cycles)
+    return trials.rows
 
 
 def arm_designer(seed: int, bound: float, truth: TargetTruth, work: Path) -> dict:
@@ -288,14 +330,33 @@ def arm_fullgrid(seed: int, truth: TargetTruth, work: Path) -> dict:
     return {"cycles": cycles, "map_error_mm": error, "error_spread_mm": spread}
 
 
-def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[list[dict], float]:
-    """One arm's curve rows on dataset ``seed`` within ``budget`` cycles, and its wall s."""
+#: Arms with no randomness of their own beyond the dataset seed's: one run a seed.
+UNREPEATED = ("grid", "designer", "fullgrid")
+#: The black-box peers of the gait goal: each evaluation one trial, no map.
+PEERS = ("bo", "tpe")
+
+
+def job_seed(arm: str, seed: int, repeat: int) -> int:
+    """The seed of run ``repeat`` of ``arm`` on dataset seed ``seed``: the dataset seed
+    itself for repeat 0 (the run `plan loop --seed S` makes), else derived from the job's
+    key. It drives all of the run's randomness: its trials' noise draws and the arm's own
+    (BO's random starts and GP, TPE's sampler, the loop's bootstrap refits)."""
+    return seed if repeat == 0 else derive_seed("adaptive", arm, seed, repeat) % 2**31
+
+
+def run_arm(
+    arm: str, goal: str, seed: int, budget: int, args, truth, repeat: int = 0
+) -> tuple[list[dict], float]:
+    """One arm's curve rows on dataset ``seed`` (run ``repeat``) within ``budget``
+    cycles, and its wall s."""
     started = time.perf_counter()
+    dataset_seed, seed = seed, job_seed(arm, seed, repeat)
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         if arm == "plan":
             # kept: a plan loop stopped half-way continues where it ended when run again
-            work = args.out / f"work-{goal}-plan-s{seed}"
+            tail = f"-r{repeat}" if repeat else ""
+            work = args.out / f"work-{goal}-plan-s{dataset_seed}{tail}"
             work.mkdir(parents=True, exist_ok=True)
         if arm == "grid":
             rows = arm_grid(seed, budget, truth, work)
@@ -311,6 +372,8 @@ def run_arm(arm: str, goal: str, seed: int, budget: int, args, truth) -> tuple[l
             rows = [arm_fullgrid(seed, truth, work)]
         elif arm == "bo":
             rows = arm_bo(seed, args.bo_budget, args.cycles, args.bound)
+        elif arm == "tpe":
+            rows = arm_tpe(seed, args.bo_budget, args.cycles, args.bound)
         else:
             rows = [arm_designer(seed, args.bound, truth, work)]
     return rows, time.perf_counter() - started
@@ -331,6 +394,91 @@ def stored_spreads(out: Path, seed: int) -> dict[int, float]:
     return dict(zip(part["cycles"].astype(int), part["error_spread_mm"].astype(float), strict=True))
 
 
+def repeats_of(arm: str, args) -> int:
+    """Runs a dataset seed of ``arm``: --peer-repeats for the black-box peers (cheap),
+    --repeats for the learning arms."""
+    return args.peer_repeats if arm in PEERS else args.repeats
+
+
+def run_stats(values: list[int | None]) -> dict:
+    """Median, least and most cycles over runs to reach a level; a run that never reached
+    it counts as more than any budget (so the median is None when half or more missed)."""
+    reached = sorted(v for v in values if v is not None)
+    ranked = reached + [np.inf] * (len(values) - len(reached))
+    median = float(np.median(ranked)) if ranked else np.inf
+    return {
+        "median": None if not np.isfinite(median) else median,
+        "min": reached[0] if reached else None,
+        "max": None if len(reached) < len(values) else reached[-1],
+        "missed": len(values) - len(reached),
+        "runs": values,
+    }
+
+
+def over_runs(runs: list[dict]) -> dict:
+    """A dataset seed's entry for one arm: the runs and their cycles to 80 % and 90 %."""
+    return {
+        "repeats": len(runs),
+        "cycles_to_80": run_stats([r["cycles_to_80"] for r in runs]),
+        "cycles_to_90": run_stats([r["cycles_to_90"] for r in runs]),
+        "median_share_of_ceiling": float(np.median([r["share_of_ceiling"] for r in runs])),
+        "runs": runs,
+    }
+
+
+def ratios(arms: dict, budget: int, peer_budget: int) -> dict:
+    """Per peer and dataset seed, the plan loop's median cycles to 80 % / 90 % over the
+    peer's (the bar: <= 1/3). Where the peer's median run missed the level within its
+    budget the ratio is an upper bound (``peer_missed``: the peer needs > peer_budget);
+    where the loop's did, None."""
+    out = {}
+    for peer in PEERS:
+        if "plan" not in arms or peer not in arms:
+            continue
+        for seed, plan in arms["plan"].items():
+            if seed not in arms[peer]:
+                continue
+            for level in ("80", "90"):
+                p = plan[f"cycles_to_{level}"]["median"]
+                q = arms[peer][seed][f"cycles_to_{level}"]["median"]
+                out.setdefault(peer, {}).setdefault(seed, {})[level] = {
+                    "ratio": None if p is None else round(p / (q or peer_budget), 3),
+                    "peer_missed": q is None,
+                }
+    return out
+
+
+def print_gait_table(summary: dict) -> None:
+    """Cycles to 80 % / 90 % of the ceiling: median [least-most] over runs, per arm and
+    dataset seed ("missed": the median run never reached it within the arm's budget)."""
+
+    def cell(st: dict) -> str:
+        if st["min"] is None:
+            return "never"
+        med = "missed" if st["median"] is None else f"{st['median']:g}"
+        high = "never" if st["max"] is None else st["max"]
+        return f"{med} [{st['min']}-{high}]" + (f" ({st['missed']} missed)" if st["missed"] else "")
+
+    for arm, per_seed in summary["arms"].items():
+        for seed, e in per_seed.items():
+            print(
+                f"{arm:>8} seed {seed} ({e['repeats']} runs): to 80 % {cell(e['cycles_to_80'])}; "
+                f"to 90 % {cell(e['cycles_to_90'])}"
+            )
+    for peer, per_seed in summary.get("ratios", {}).items():
+        for seed, r in per_seed.items():
+            text = ", ".join(f"{lv} %: {ratio_text(v)}" for lv, v in r.items())
+            print(f"plan / {peer} seed {seed} (ratio of medians): {text}")
+
+
+def ratio_text(r: dict) -> str:
+    """A ratio of medians as printed: '-' when the loop's median run missed, '<= x' when
+    the peer's did (x the bound at its budget)."""
+    if r["ratio"] is None:
+        return "-"
+    return ("<= " if r["peer_missed"] else "") + f"{r['ratio']:g}"
+
+
 def first_reaching(rows: list[dict], level: float) -> int | None:
     """Cycles recorded when the best gait first reaches ``level`` mm per cycle."""
     for r in rows:
@@ -348,8 +496,15 @@ def main(argv=None) -> None:
     ap.add_argument("--cycles", type=int, default=5, help="cycles per planned/random/BO trial")
     ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
     ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
-    ap.add_argument("--arms", default="grid,random,plan,bo", help="gait-goal arms ('' for none)")
+    ap.add_argument("--arms", default="grid,random,plan,bo,tpe", help="gait-goal arms ('' none)")
     ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
+    ap.add_argument(
+        "--repeats", type=int, default=3,
+        help="runs a dataset seed of the plan loop and random arms (seeds from the job key)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--peer-repeats", type=int, default=5, help="runs a dataset seed of BO and TPE"
+    )  # fmt: skip
     ap.add_argument(
         "--spread-boots", type=int, default=8,
         help="bootstrap refits of the map error's spread (the flattening check)",
@@ -367,6 +522,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     if args.quick:
         args.seeds, args.budget, args.cycles, args.arms = "0", 6, 2, "random,plan"
+        args.repeats, args.peer_repeats = 2, 2
         args.map_budget, args.map_arms, args.spread_boots = 6, "random", 2
         args.out = Path(tempfile.mkdtemp(prefix="suds-adaptive-quick-"))
         atexit.register(shutil.rmtree, args.out, True)
@@ -375,25 +531,34 @@ def main(argv=None) -> None:
     arms = [a for a in args.arms.split(",") if a]
     truth = TargetTruth(Target.of(bound=args.bound))
     curves, summary = [], {"ceiling_mm": args.ceiling, "seeds": seeds, "arms": {}}
+    summary |= {"budget": args.budget, "peer_budget": args.bo_budget}
     for seed in seeds:
         for arm in arms + (["designer"] if args.designer else []):
-            rows, seconds = run_arm(arm, "gait", seed, args.budget, args, truth)
-            curves += [{"goal": "gait", "arm": arm, "seed": seed} | r for r in rows]
-            last = rows[-1]
-            entry = {
-                "cycles": last["cycles"],
-                "best_forward_mm": round(last["best_forward_mm"], 2),
-                "share_of_ceiling": round(last["best_forward_mm"] / args.ceiling, 3),
-                "cycles_to_80": first_reaching(rows, 0.8 * args.ceiling),
-                "cycles_to_90": first_reaching(rows, 0.9 * args.ceiling),
-                "seconds": round(seconds, 1),
-            }
-            if arm == "designer":
-                entry["grid_cycles"] = last["grid_cycles"]
-                entry["grid_map_error_mm"] = round(last["grid_map_error_mm"], 3)
-            summary["arms"].setdefault(arm, {})[str(seed)] = entry
-            print(f"gait seed {seed} {arm}: {entry}", flush=True)
-            save(curves, summary, args.out)
+            runs = []
+            for repeat in range(1 if arm in UNREPEATED else repeats_of(arm, args)):
+                rows, seconds = run_arm(arm, "gait", seed, args.budget, args, truth, repeat)
+                curves += [
+                    {"goal": "gait", "arm": arm, "seed": seed, "repeat": repeat} | r for r in rows
+                ]
+                last = rows[-1]
+                entry = {
+                    "repeat": repeat,
+                    "job_seed": job_seed(arm, seed, repeat),
+                    "cycles": last["cycles"],
+                    "best_forward_mm": round(last["best_forward_mm"], 2),
+                    "share_of_ceiling": round(last["best_forward_mm"] / args.ceiling, 3),
+                    "cycles_to_80": first_reaching(rows, 0.8 * args.ceiling),
+                    "cycles_to_90": first_reaching(rows, 0.9 * args.ceiling),
+                    "seconds": round(seconds, 1),
+                }
+                if arm == "designer":
+                    entry["grid_cycles"] = last["grid_cycles"]
+                    entry["grid_map_error_mm"] = round(last["grid_map_error_mm"], 3)
+                runs.append(entry)
+                print(f"gait seed {seed} {arm} run {repeat}: {entry}", flush=True)
+                summary["arms"].setdefault(arm, {})[str(seed)] = over_runs(runs)
+                summary["ratios"] = ratios(summary["arms"], args.budget, args.bo_budget)
+                save(curves, summary, args.out)
         map_arms = [a for a in args.map_arms.split(",") if a]
         for arm in map_arms if args.map_budget > 0 else ():
             rows, seconds = run_arm(arm, "map", seed, args.map_budget, args, truth)
@@ -410,6 +575,7 @@ def main(argv=None) -> None:
             summary.setdefault("map", {}).setdefault(arm, {})[str(seed)] = entry
             print(f"map seed {seed} {arm}: {entry}", flush=True)
             save(curves, summary, args.out)
+    print_gait_table(summary)
     draw(pd.DataFrame(curves), args.ceiling, args.out)
     print(f"wrote {args.out}/curves.csv, summary.json and figures")
 
@@ -428,6 +594,7 @@ def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
     import matplotlib.pyplot as plt
 
     colours = {"grid": "C0", "random": "C1", "plan": "C2", "bo": "C3", "designer": "C4"}
+    colours["tpe"] = "C5"
     colours["fullgrid"] = "C0"
     for goal, column, label in (
         ("gait", "best_forward_mm", "best gait on the simulator (share of the ceiling)"),
@@ -437,7 +604,9 @@ def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
         if part.empty:
             continue
         fig, ax = plt.subplots(figsize=(7, 4.2))
-        for (arm, seed), rows in part.groupby(["arm", "seed"]):
+        if "repeat" not in part:
+            part = part.assign(repeat=0)
+        for (arm, seed, _), rows in part.groupby(["arm", "seed", "repeat"], dropna=False):
             y = rows[column] / ceiling if goal == "gait" else rows[column]
             style = "o" if len(rows) == 1 else "-"
             ax.plot(
