@@ -94,8 +94,7 @@ suds-exp sql "SELECT table_name, table_type FROM information_schema.tables WHERE
 python - "$REPO" <<'EOF'
 import json, sys
 from pathlib import Path
-sys.path.insert(0, sys.argv[1])
-from tests.migration_text import created_by_migrations
+from suds_exp.testing.migration_text import created_by_migrations
 tables, views = created_by_migrations(Path(sys.argv[1], "migrations"))
 rows = json.load(open("catalog.json"))
 got_t = {r["table_name"] for r in rows if r["table_type"] == "BASE TABLE"}

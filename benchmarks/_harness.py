@@ -1,5 +1,6 @@
-"""What the commit comparisons share: a baseline's export, alternating rounds, the worker
-process and the median/ratio table.
+"""What the benchmark scripts share: the command line with its ``--quick`` smoke mode, and
+for the commit comparisons a baseline's export, alternating rounds, the worker process and
+the median/ratio table.
 
 A comparison runs the same worker on two trees: an export of the baseline commit (`git
 archive` of `suds_exp/`, `cli.py` and `pyproject.toml` into a temporary folder) and the
@@ -12,6 +13,7 @@ itself (an export holds no `benchmarks/`). It prints one JSON document as its la
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import subprocess
@@ -111,3 +113,13 @@ def table(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
+
+
+def script_parser(
+    description: str, quick: str = "a smoke run at tiny sizes"
+) -> argparse.ArgumentParser:
+    """A script's argument parser with its ``--quick`` flag (help ``quick``), the smoke mode
+    every script has and tests/test_benchmarks_smoke.py runs."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--quick", action="store_true", help=quick)
+    return parser

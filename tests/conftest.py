@@ -148,6 +148,25 @@ def sql():
     return rows
 
 
+@pytest.fixture(scope="session")
+def simulated_db():
+    """``simulated_db(work, gaits, freqs="1/2", repeats=2, cycles=6)``: the path of a database
+    in folder ``work`` made as a user would (``suds-exp simulate --ingest``, then
+    ``preprocess``: version v1) of ``gaits`` (e.g. "O,D+") at ``freqs`` Hz, ``repeats``
+    trials of ``cycles`` cycles each."""
+
+    def make(work: Path, gaits: str, freqs: str = "1/2", repeats: int = 2, cycles: int = 6):
+        db = work / "simulated.duckdb"
+        simulate = ["simulate", "--out", work / "d", "--gaits", gaits, "--freqs", freqs,
+                    "--repeats", repeats, "--cycles", cycles, "--ingest"]  # fmt: skip
+        for args in (simulate, ["preprocess"]):
+            out = _cli(*args, "--db", db, "-q")
+            assert out.exit_code == 0, out.output
+        return db
+
+    return make
+
+
 # -- campaigns --------------------------------------------------------------------------
 @pytest.fixture(scope="session")
 def campaign_rows():

@@ -33,10 +33,10 @@ from suds_exp.sim import (
 from suds_exp.sim.effect_params import (
     EFFECTS,
     effect,
-    kernel_layout,
     main_param,
     unregister_effect,
 )
+from suds_exp.sim.kernel_params import kernel_layout
 from suds_exp.sim.mechanics import pack_params
 
 

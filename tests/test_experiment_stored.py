@@ -308,28 +308,9 @@ def _own_toml(folder: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
+def tiny(tmp_path_factory, simulated_db) -> Path:
     """The README tour's small campaign: one gait, 2 draws, 2 cycles (paper design)."""
-    work = tmp_path_factory.mktemp("tiny")
-    db = work / "tiny.duckdb"
-    ok(
-        "simulate",
-        "--out",
-        work / "d",
-        "--gaits",
-        "O",
-        "--freqs",
-        "1/2",
-        "--repeats",
-        2,
-        "--cycles",
-        6,
-        "--ingest",
-        "--db",
-        db,
-        "-q",
-    )
-    ok("preprocess", "--db", db, "-q")
+    db = simulated_db(tmp_path_factory.mktemp("tiny"), "O", "1/2", repeats=2, cycles=6)
     ok(
         "run",
         "tiny",

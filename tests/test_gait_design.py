@@ -27,29 +27,9 @@ def ok(*args: str) -> str:
 
 
 @pytest.fixture(scope="module")
-def small(tmp_path_factory) -> Path:
+def small(tmp_path_factory, simulated_db) -> Path:
     """O and D+ at 1/2 Hz, 2 repeats of 6 cycles, ingested and preprocessed."""
-    work = tmp_path_factory.mktemp("gait-small")
-    db = work / "small.duckdb"
-    ok(
-        "simulate",
-        "--out",
-        str(work / "d"),
-        "--gaits",
-        "O,D+",
-        "--freqs",
-        "1/2",
-        "--repeats",
-        "2",
-        "--cycles",
-        "6",
-        "--ingest",
-        "--db",
-        str(db),
-        "-q",
-    )
-    ok("preprocess", "--db", str(db), "-q")
-    return db
+    return simulated_db(tmp_path_factory.mktemp("gait-small"), "O,D+", "1/2", repeats=2, cycles=6)
 
 
 @pytest.fixture

@@ -18,6 +18,7 @@ from suds_exp.campaign import CampaignOptions, run_campaign
 from suds_exp.commands.campaign import parse_campaign_options
 from suds_exp.errors import ConfigError
 from suds_exp.models import make_model, model_recipe
+from suds_exp.models.baselines import JUDGED_RECIPES
 from suds_exp.store import Store
 from suds_exp.testing.database import dump_db
 from suds_exp.testing.synthetic_samples import synthetic_samples
@@ -473,20 +474,8 @@ def test_the_seed_tolerance_needs_two_seeds():
 def test_the_baselines_defaults_are_the_recipe_judged_in_the_speed_results():
     # docs/results/speed.md, "Session 15": every faster setting tried was outside the
     # baselines' own seed-to-seed spread, so the defaults stay the old recipe; a change of
-    # default must be judged again with benchmarks/studies/survey_tolerance.py (whose OLD_RECIPES
-    # are these values: the recipe it judged, pinned here).
-    judged = {
-        "MLP": {"hidden_layer_sizes": [64, 64], "max_iter": 200, "tol": 1e-4},
-        "GBT": {
-            "max_iter": 200,
-            "learning_rate": 0.1,
-            "max_leaf_nodes": 31,
-            "max_bins": 255,
-            "n_iter_no_change": 10,
-        },
-        "KRR": {"n_components": 300},
-    }
+    # default must be judged again with benchmarks/studies/survey_tolerance.py.
     for name in ("MLP", "MLP+SUDS", "GBT", "KRR"):
         params = make_model(name).estimator.get_params()
-        for key, value in judged[name.removesuffix("+SUDS")].items():
+        for key, value in JUDGED_RECIPES[name.removesuffix("+SUDS")].items():
             assert params[key] == (tuple(value) if isinstance(value, list) else value), key

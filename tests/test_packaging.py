@@ -21,7 +21,7 @@ from typer.testing import CliRunner
 import suds_exp
 from cli import app
 from suds_exp.store import migrate
-from tests.migration_text import created_by_migrations
+from suds_exp.testing.migration_text import created_by_migrations
 
 REPO = Path(__file__).resolve().parents[1]
 runner = CliRunner()

@@ -8,26 +8,14 @@ import pytest
 from scipy.signal import savgol_filter
 
 from suds_exp.errors import ConfigError
-from suds_exp.preprocess.body_frame import SegmentFrames, body_pose, fit_joints
+from suds_exp.preprocess.body_frame import body_pose
+from suds_exp.preprocess.body_model import SwimmerModel
 from suds_exp.preprocess.chain import chain_pose, chain_settings
 from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.kinematics import kinematics, measure
 from suds_exp.preprocess.params import DEFAULTS, resolve_params
 from suds_exp.preprocess.rates import body_velocity, derivative, local_polynomial
-from suds_exp.testing.synthetic_captures import synthetic_trial
-
-GAITS = [("O", 0.5), ("D+", 1.0), ("S+", 1 / 3), ("D-", 0.5), ("S-", 1.0)]
-
-
-def _joints(measured):
-    return fit_joints(
-        SegmentFrames(
-            *[
-                np.concatenate([getattr(m.frames, a) for m in measured])
-                for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
-            ]
-        )
-    )
+from suds_exp.testing.synthetic_captures import synthetic_trials
 
 
 def _pose_errors(xy, heading, truth):
@@ -40,11 +28,9 @@ def _pose_errors(xy, heading, truth):
 
 
 def test_noise_free_chain_pose_is_the_segment_pose():
-    trials = [
-        synthetic_trial(g, f, n_cycles=4, noise_mm=0.0, seed=i) for i, (g, f) in enumerate(GAITS)
-    ]
+    trials = synthetic_trials(n_cycles=4, noise_mm=0.0)
     measured = [measure(t.xyz) for t in trials]
-    joints = _joints(measured)
+    joints = SwimmerModel().fit_joints(measured)
     for t, m in zip(trials, measured, strict=True):
         pose = body_pose(m.frames, joints)
         # unsmoothed relative angles: the same pose to rounding
@@ -59,12 +45,9 @@ def test_noise_free_chain_pose_is_the_segment_pose():
 
 
 def test_chain_pose_is_less_noisy_than_the_segment_pose_and_so_is_the_velocity():
-    trials = [
-        synthetic_trial(g, f, n_cycles=6, noise_mm=0.2, n_jumps=3, n_dropouts=3, seed=20 + i)
-        for i, (g, f) in enumerate(GAITS)
-    ]
+    trials = synthetic_trials(n_cycles=6, noise_mm=0.2, n_jumps=3, n_dropouts=3, seed=20)
     measured = [measure(clean_tracks(t.xyz).xyz) for t in trials]
-    joints = _joints(measured)
+    joints = SwimmerModel().fit_joints(measured)
     seg_xy, seg_th, ch_xy, ch_th, seg_v, ch_v = [], [], [], [], [], []
     for t, m in zip(trials, measured, strict=True):
         segments = kinematics(m, joints)

@@ -6,30 +6,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from suds_exp.preprocess.body_frame import SegmentFrames, fit_joints
+from suds_exp.preprocess.body_model import SwimmerModel
 from suds_exp.preprocess.kinematics import kinematics, measure
 from suds_exp.preprocess.rates import body_velocity, derivative, smooth, window_frames
 from suds_exp.preprocess.shape import PassivePCA
-from suds_exp.testing.synthetic_captures import MIDDLE_MM, synthetic_trial
-
-GAITS = [("O", 0.5), ("D+", 1.0), ("S+", 1 / 3), ("D-", 0.5), ("S-", 1.0)]
-
-
-def pooled_joints(measured):
-    frames = SegmentFrames(
-        *[
-            np.concatenate([getattr(m.frames, a) for m in measured])
-            for a in ("head_origin", "head_angle", "tail_origin", "tail_angle")
-        ]
-    )
-    return fit_joints(frames)
+from suds_exp.testing.synthetic_captures import MIDDLE_MM, synthetic_trial, synthetic_trials
 
 
 @pytest.fixture(scope="module")
 def clean_trials():
-    trials = [
-        synthetic_trial(g, f, n_cycles=5, noise_mm=0.0, seed=i) for i, (g, f) in enumerate(GAITS)
-    ]
+    trials = synthetic_trials(n_cycles=5, noise_mm=0.0)
     return trials, [measure(t.xyz) for t in trials]
 
 
@@ -48,7 +34,7 @@ def test_plane_is_recovered_from_a_tilted_capture(clean_trials):
 
 def test_motor_axes_are_the_points_at_constant_distance(clean_trials):
     trials, measured = clean_trials
-    joints = pooled_joints(measured)
+    joints = SwimmerModel().fit_joints(measured)
     assert joints.length_mm == pytest.approx(MIDDLE_MM, abs=1e-4)
     assert joints.rms_mm < 1e-4
     # head joint seen from the head top markers' frame (centroid (55, 0), axis to (75, -10))
@@ -62,7 +48,7 @@ def test_motor_axes_are_the_points_at_constant_distance(clean_trials):
 
 def test_noise_free_pose_shape_and_velocity_match_the_truth(clean_trials):
     trials, measured = clean_trials
-    joints = pooled_joints(measured)
+    joints = SwimmerModel().fit_joints(measured)
     for trial, m in zip(trials, measured, strict=True):
         kin = kinematics(m, joints)
         truth = trial.truth
@@ -76,14 +62,11 @@ def test_noise_free_pose_shape_and_velocity_match_the_truth(clean_trials):
 
 
 def test_noisy_capture_gives_ra_within_a_hundredth_of_a_radian():
-    trials = [
-        synthetic_trial(g, f, n_cycles=6, noise_mm=0.2, n_jumps=5, n_dropouts=5, seed=10 + i)
-        for i, (g, f) in enumerate(GAITS)
-    ]
+    trials = synthetic_trials(n_cycles=6, noise_mm=0.2, n_jumps=5, n_dropouts=5, seed=10)
     from suds_exp.preprocess.clean import clean_tracks
 
     measured = [measure(clean_tracks(t.xyz).xyz) for t in trials]
-    joints = pooled_joints(measured)
+    joints = SwimmerModel().fit_joints(measured)
     errors = []
     for trial, m in zip(trials, measured, strict=True):
         ra = smooth(kinematics(m, joints).ra, 21, 5)
@@ -93,7 +76,7 @@ def test_noisy_capture_gives_ra_within_a_hundredth_of_a_radian():
 
 def test_passive_state_and_pca(clean_trials):
     trials, measured = clean_trials
-    joints = pooled_joints(measured)
+    joints = SwimmerModel().fit_joints(measured)
     passive = np.concatenate([kinematics(m, joints).passive for m in measured])
     # head spoke in the head frame: fixed at (55, 8) mm
     np.testing.assert_allclose(passive[:, :2], np.tile([55.0, 8.0], (len(passive), 1)), atol=1e-5)

@@ -2,7 +2,8 @@
 refused, file-system errors and refusals in one line with the database byte-identical,
 Ctrl-C and kill -9 ending a campaign and its workers cleanly.
 
-The probe itself is `tests/reliability_probe.py` (`python -m tests.reliability_probe`
+The probe itself is `suds_exp/testing/reliability_probe.py`
+(`python -m suds_exp.testing.reliability_probe`
 prints the counts of the long version); these tests run a few of its cases, the long ones
 marked slow.
 """
@@ -26,8 +27,9 @@ from suds_exp.errors import StoreError
 from suds_exp.store import Store
 from suds_exp.store import lock as write_lock
 from suds_exp.store.engine import lock_holder
-from tests import reliability_probe as probe
+from suds_exp.testing import reliability_probe as probe
 
+REPO = Path(__file__).resolve().parents[1]
 runner = CliRunner()
 
 
@@ -117,7 +119,7 @@ with WriteLock(sys.argv[1], "preprocess", "v9"):
 def test_a_second_writer_is_refused_in_one_line_naming_the_holder(data, tmp_path, monkeypatch):
     db = fresh(data.prepped, tmp_path)
     holder = subprocess.Popen(
-        [sys.executable, "-c", HOLD, str(db)], cwd=probe.REPO, stdout=subprocess.PIPE, text=True
+        [sys.executable, "-c", HOLD, str(db)], cwd=REPO, stdout=subprocess.PIPE, text=True
     )
     try:
         assert holder.stdout.readline().strip() == "held"

@@ -8,8 +8,6 @@ import ast
 from pathlib import Path
 
 HERE = Path(__file__).parent
-#: Modules of tests/ that are not tests but what tests drive (docs/architecture.md).
-SUPPORT = {"reliability_probe", "migration_text"}
 
 
 def imported_modules(path: Path) -> set[str]:
@@ -27,13 +25,12 @@ def imported_modules(path: Path) -> set[str]:
 def test_no_test_module_imports_another_conftest_or_the_benchmarks():
     bad = {}
     for path in sorted(HERE.glob("*.py")):
-        if path.name == "conftest.py" or path.stem in SUPPORT:
+        if path.name == "conftest.py":
             continue
         wrong = sorted(
             m
             for m in imported_modules(path)
-            if m.split(".")[0] in ("conftest", "benchmarks")
-            or (m.startswith("tests.") and m.split(".")[1] not in SUPPORT)
+            if m.split(".")[0] in ("conftest", "benchmarks", "tests")
         )
         if wrong:
             bad[path.name] = wrong

@@ -102,12 +102,15 @@ def test_only_preprocess_reads_its_tables():
 
     root = Path(__file__).resolve().parents[1] / "suds_exp"
     table = re.compile(r"\bprep_(?:pca|fits|versions|trials)\b")
+    # the reliability probe checks every table's unique keys in SQL, as a user could: it
+    # reads the whole database, not a version
+    whole_database = {"testing/reliability_probe.py"}
     readers = [
         str(p.relative_to(root))
         for p in root.rglob("*.py")
         if p.parent.name != "preprocess" and table.search(p.read_text())
     ]
-    assert readers == []
+    assert sorted(set(readers) - whole_database) == []
 
 
 def test_unnamed_runs_started_in_the_same_second_get_names_of_their_own(

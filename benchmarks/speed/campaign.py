@@ -61,7 +61,6 @@ import resource
 import statistics
 import tempfile
 import time
-from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -70,7 +69,7 @@ from joblib import parallel_config
 from threadpoolctl import threadpool_limits
 
 from benchmarks._data import SMALL, fresh_store, paper_like_samples, small_grid_jobs
-from benchmarks._harness import alternate, worker
+from benchmarks._harness import alternate, script_parser, worker
 from suds_exp.campaign import CampaignOptions, enumerate_draws, run_campaign
 from suds_exp.campaign.bank import rounded_conditions
 from suds_exp.campaign.conditions import PAPER_SWEEP
@@ -78,6 +77,7 @@ from suds_exp.campaign.definition import resolve_models
 from suds_exp.campaign.job import RESULT_COLUMNS
 from suds_exp.models import make_model
 from suds_exp.models.registry import LEARNERS
+from suds_exp.testing.synthetic_results import finished_rows
 
 #: The sizes of a run; `_quick` shrinks them for a smoke run.
 BOOTS = 3
@@ -313,30 +313,8 @@ def resume_seconds(samples, folder, repeats):
     draws = enumerate_draws("big", have, have, RESUME_BOOTS, CYCLES, [])
     n = len(draws) * len(MODELS)
     keys = [(d, m) for d in draws for m in MODELS]
-    rows = pd.DataFrame(
-        {
-            "campaign": "big",
-            "model": [m for _, m in keys],
-            "train_gait": [d.train[0] for d, _ in keys],
-            "train_frequency_hz": [d.train[1] for d, _ in keys],
-            "test_gait": [d.test[0] for d, _ in keys],
-            "test_frequency_hz": [d.test[1] for d, _ in keys],
-            "boot": [d.boot for d, _ in keys],
-            "n_cycles": CYCLES,
-            "train_trials": "[1]",
-            "train_ranges": f"[[1, 1, {CYCLES}]]",
-            "test_trial": 2,
-            "test_range": f"[1, {CYCLES}]",
-            "rmse_vx": np.random.default_rng(0).uniform(1, 10, n),
-            "rmse_vy": 1.0,
-            "rmse_wz": 0.1,
-            "n_test": 3000,
-            "fit_seconds": 0.1,
-            "predict_seconds": 0.01,
-            "finished_at": datetime(2026, 1, 1),
-            "error": None,
-        }
-    )[list(RESULT_COLUMNS)]
+    rmse_vx = np.random.default_rng(0).uniform(1, 10, n)
+    rows = finished_rows(keys, "big", CYCLES, rmse_vx)[list(RESULT_COLUMNS)]
     with store.write() as conn:
         store.insert_df(conn, "results", rows)
     first = run_campaign(store, "big", options, samples=samples, progress=False)
@@ -403,7 +381,7 @@ def worker_peak_rss():
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--no-projection", action="store_true")
     ap.add_argument("--json", action="store_true")
@@ -415,7 +393,6 @@ def main(argv=None):
         default=0,
         help="with --baseline: measure on the paper's grid with this many draws a cell",
     )
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.quick:

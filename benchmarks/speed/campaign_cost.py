@@ -47,7 +47,7 @@ from pathlib import Path
 from statistics import median
 
 from benchmarks import _data
-from benchmarks._harness import alternate, same, worker
+from benchmarks._harness import alternate, same, script_parser, worker
 
 #: A smoke run's sizes: trial cycles, training cycles, learners.
 QUICK = (8, 5, ["phase-only", "TLS"])
@@ -159,13 +159,12 @@ def _figures(r: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="3454561")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--boots", type=int, default=1)
     ap.add_argument("--sweep", default="1,4,16,30,48")
     ap.add_argument("--writes", type=int, default=0, help="time N batch writes instead")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.quick and not a.worker:

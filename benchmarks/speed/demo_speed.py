@@ -36,7 +36,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import ROOT, baseline_tree, run_in, same, speedup, worker
+from benchmarks._harness import ROOT, baseline_tree, run_in, same, script_parser, speedup, worker
 
 STEPS = ("simulate", "discrepancy")
 #: ``--quick``'s design: one trial of two cycles.
@@ -84,11 +84,10 @@ def measure(step: str, quick: bool = False) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="3454561")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--steps", nargs="+", choices=STEPS, default=list(STEPS))
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", choices=STEPS, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:

@@ -17,7 +17,6 @@ round on one draw of 5 cycles, K = 4 (a smoke run, no figure).
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import subprocess
 import sys
@@ -30,7 +29,7 @@ from threadpoolctl import threadpool_limits
 
 import suds_exp.models.gmr as gmr_module
 from benchmarks import _data
-from benchmarks._harness import ROOT
+from benchmarks._harness import ROOT, script_parser
 from suds_exp.models import make_model
 from suds_exp.models import mixture as new
 
@@ -73,10 +72,9 @@ def em_inputs(n_draws: int = 4, cycles: int = 30, trial_cycles: int = 25) -> lis
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="c2aa7be")
     ap.add_argument("--rounds", type=int, default=7)
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     a = ap.parse_args(argv)
     k, sizes = 16, {}
     if a.quick:

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import alternate, same, worker
+from benchmarks._harness import alternate, same, script_parser, worker
 
 
 def measure(draws: int, boot: int) -> dict:
@@ -47,12 +47,11 @@ def measure(draws: int, boot: int) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="HEAD", help="commit to compare against")
     ap.add_argument("--draws", type=int, default=100, help="draws per pair")
     ap.add_argument("--boot", type=int, default=400, help="bootstrap replicates")
     ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.quick:

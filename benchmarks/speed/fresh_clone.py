@@ -22,7 +22,6 @@ machinery, no install).
 
 from __future__ import annotations
 
-import argparse
 import os
 import re
 import shutil
@@ -34,7 +33,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import ROOT
+from benchmarks._harness import ROOT, script_parser
 
 
 def _git(*args: str, cwd: Path = ROOT) -> str:
@@ -97,12 +96,11 @@ def one_round(commit: str, target: str, keep: bool, dry_run: bool = False) -> di
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0], "a smoke run: make --dry-run")
     ap.add_argument("--baseline", default="b16e0d5", help="commit to compare with")
     ap.add_argument("--rounds", type=int, default=3, help="rounds per side")
     ap.add_argument("--target", default="test", choices=("test", "demo"))
     ap.add_argument("--keep", action="store_true", help="keep the clones")
-    ap.add_argument("--quick", action="store_true", help="a smoke run: make --dry-run")
     args = ap.parse_args(argv)
     if args.quick:
         args.rounds = 1

@@ -12,7 +12,6 @@ from `suds_exp.testing.synthetic_captures` (random tracks with no truth to keep)
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import tempfile
 import time
@@ -20,17 +19,17 @@ from pathlib import Path
 
 import pandas as pd
 
+from benchmarks._harness import script_parser
 from suds_exp.ingest import ROLES, ingest_paths
 from suds_exp.store import Store
 from suds_exp.testing.synthetic_captures import qtm_text, random_track
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = script_parser(__doc__.splitlines()[0])
     parser.add_argument("--files", type=int, default=60)
     parser.add_argument("--frames", type=int, default=4000)
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = parser.parse_args(argv)
     if args.quick:
         args.files, args.frames, args.repeats = 2, 200, 1

@@ -33,7 +33,7 @@ import time
 from statistics import median
 
 from benchmarks import _data
-from benchmarks._harness import alternate, same, speedup, worker
+from benchmarks._harness import alternate, same, script_parser, speedup, worker
 
 PAPER_FIVE = ("phase-only", "TLS", "TLS+SUDS", "GMR", "GMR+SUDS")
 CASES = [
@@ -92,7 +92,7 @@ def _run(tree, a) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="c2aa7be")
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--repeats", type=int, default=5)
@@ -100,7 +100,6 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=4, help="bootstrap draws per learner")
     ap.add_argument("--models", default=None, help="learners, comma-separated (default: CASES)")
     ap.add_argument("--trial-cycles", type=int, default=25, help="cycles of each trial")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.quick:

@@ -41,7 +41,6 @@ run, no figure).
 
 from __future__ import annotations
 
-import argparse
 import time
 from statistics import median
 
@@ -49,6 +48,7 @@ import numpy as np
 import pandas as pd
 
 from benchmarks._data import PAPER, SURVEY, swimmer_samples
+from benchmarks._harness import script_parser
 from suds_exp.models import make_model
 from suds_exp.models.mixture import conditional_mean, fit_mixture
 from suds_exp.models.registry import LEARNERS, SURVEY_LEARNERS
@@ -327,13 +327,12 @@ def mlp_curve(trials, epochs=(5, 10, 20, 30, 40, 60, 80, 100, 150, 200)):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--boots", type=int, default=3)
     ap.add_argument("--data", choices=("sim", "synthetic"), default="sim")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--skip", nargs="*", default=[], choices=("timing", "gmr", "ablation", "curve"))
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     learners = None
     if args.quick:

@@ -26,7 +26,6 @@ smoke run whose figures mean nothing.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shutil
@@ -36,6 +35,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from benchmarks._harness import script_parser
 from suds_exp.body import load_body, preprocess_body
 from suds_exp.commands.simulate import simulate_command
 from suds_exp.preprocess import preprocess
@@ -47,14 +47,13 @@ QUICK_DESIGN = {"gaits": ("O", "D+"), "frequencies_hz": (0.5, 1.0), "repeats": 2
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = script_parser(__doc__.split("\n\n")[0])
     parser.add_argument("--db", type=Path, help="Database already holding the dataset.")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--json", action="store_true")
     parser.add_argument(
         "--body", help="Preprocess through this body description (e.g. swimmer) instead."
     )
-    parser.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = parser.parse_args(argv)
     design = {}
     if args.quick:

@@ -10,13 +10,13 @@ Writes the results into a temporary database once, then writes the full report
 
 from __future__ import annotations
 
-import argparse
 import math
 import statistics
 import tempfile
 import time
 from pathlib import Path
 
+from benchmarks._harness import script_parser
 from suds_exp.analysis import write_report
 from suds_exp.store import Store
 from suds_exp.testing.synthetic_results import synthetic_results
@@ -26,10 +26,9 @@ TARGET_S = 60.0
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = script_parser(__doc__.splitlines()[0])
     parser.add_argument("--rows", type=int, default=100_000, help="approximate number of results")
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = parser.parse_args(argv)
     if args.quick:
         args.rows, args.repeats = 1, 1

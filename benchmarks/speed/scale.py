@@ -45,7 +45,7 @@ import time
 from pathlib import Path
 
 from benchmarks._data import paper_like_samples
-from benchmarks._harness import ROOT
+from benchmarks._harness import ROOT, script_parser
 
 CAMPAIGN = "scale"
 PAIRS_X_LEARNERS = 15 * 15 * 5
@@ -154,14 +154,13 @@ def exponent(n1: float, v1: float, n2: float, v2: float) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="0.1,1,5,10", help="millions of results, comma-separated")
     ap.add_argument("--folder", type=Path, default=Path(tempfile.gettempdir()) / "suds_scale")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--commands", default=",".join(COMMANDS))
     ap.add_argument("--findings-boots", type=int, default=400)
     ap.add_argument("--json", type=Path, default=None, help="also write the figures here")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     ap.add_argument("--resume-worker", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--measure", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)

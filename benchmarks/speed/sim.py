@@ -19,7 +19,6 @@ cycles, the figure into a temporary folder (a smoke run, no figure to quote).
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import tempfile
 import time
@@ -27,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks._harness import table
+from benchmarks._harness import script_parser, table
 from suds_exp.sim import (
     FREQUENCIES_HZ,
     GAITS,
@@ -146,14 +145,13 @@ def path_figure(specs, truths, out: Path) -> Path:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", type=Path, default=Path("reports/sim-benchmark"))
     ap.add_argument(
         "--set", nargs="*", default=[], help="effects over the nominal robot, EFFECT.PARAM=VALUE"
     )
     ap.add_argument("--speed-only", action="store_true", help="skip the motion tables")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     if args.quick:
         args.runs = 1

@@ -13,7 +13,6 @@ database: one simulated trial, preprocessed, a 10-job campaign) runs as a whole
 
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
 import sys
@@ -22,7 +21,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import ROOT, alternate
+from benchmarks._harness import ROOT, alternate, script_parser
 
 COMMANDS = {
     "--version": ["--version"],
@@ -62,10 +61,9 @@ def _database(folder: Path) -> Path:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="HEAD")
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     a = ap.parse_args(argv)
     commands = COMMANDS
     if a.quick:

@@ -36,7 +36,6 @@ as settings finish (an interrupted run keeps them; a re-run skips them), and a s
 
 from __future__ import annotations
 
-import argparse
 import json
 import tempfile
 import time
@@ -47,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from benchmarks._data import QUICK_DESIGN
-from benchmarks._harness import ROOT
+from benchmarks._harness import ROOT, script_parser
 from suds_exp.analysis.findings import findings
 from suds_exp.campaign import CampaignOptions, run_campaign
 from suds_exp.ingest import ingest_paths
@@ -204,7 +203,7 @@ def summary(table: pd.DataFrame) -> str:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0], "a smoke run on a tiny design")
     ap.add_argument("--settings", default="", help="named settings: " + ", ".join(NAMED))
     ap.add_argument("--search", type=int, default=0, help="draw this many settings")
     ap.add_argument("--rng", type=int, default=0, help="seed of the search's draws")
@@ -218,7 +217,6 @@ def main(argv=None) -> None:
     ap.add_argument("--out", type=Path, default=Path("bench-calibrate.csv"))
     ap.add_argument("--springs", default="", help="hinge springs, N mm/rad (default nominal)")
     ap.add_argument("--train-cycles", type=int, default=30)
-    ap.add_argument("--quick", action="store_true", help="a smoke run on a tiny design")
     args = ap.parse_args(argv)
     args.design = {}
     if args.quick:

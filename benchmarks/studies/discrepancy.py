@@ -37,7 +37,6 @@ Rows are appended to --out as runs finish, so an interrupted benchmark keeps its
 
 from __future__ import annotations
 
-import argparse
 import functools
 import tempfile
 import time
@@ -46,6 +45,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks._harness import script_parser
 from suds_exp.robot import GAITS
 from suds_exp.workflows.hidden_effects import HIDDEN, draw_hidden, hidden_effect_run
 
@@ -285,7 +285,7 @@ def run_plan(plan, out: Path, key: str, run) -> pd.DataFrame:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0], "a smoke run: one small hidden run")
     ap.add_argument("--seeds", type=int, default=3, help="seeds per hidden effect")
     ap.add_argument("--first-seed", type=int, default=0, help="start at seed 100 + this")
     ap.add_argument(
@@ -316,7 +316,6 @@ def main(argv=None) -> None:
     ap.add_argument("--detection", metavar="EFFECT", help="detection limit of this effect")
     ap.add_argument("--values", help="with --detection: parameter values, comma-separated")
     ap.add_argument("--detection-seeds", default="11,12,13", help="with --detection")
-    ap.add_argument("--quick", action="store_true", help="a smoke run: one small hidden run")
     args = ap.parse_args(argv)
     if args.quick:
         with tempfile.TemporaryDirectory(prefix="suds-discrepancy-quick-") as tmp:

@@ -18,7 +18,6 @@ Needs ../shared/refdata/hatton_granular_three_link_connection.mat (or --table).
 
 from __future__ import annotations
 
-import argparse
 import datetime as _dt
 import json
 import os
@@ -30,7 +29,7 @@ import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 from scipy.io import loadmat
 
-from benchmarks._harness import ROOT
+from benchmarks._harness import ROOT, script_parser
 from suds_exp.discrepancy import DiscrepancyOptions, run_discrepancy
 from suds_exp.sim.config import SimConfig
 from suds_exp.sim.dataset import plan_trials, simulate_trials, truth_markers
@@ -121,11 +120,10 @@ def make_dataset(work: Path, table: Path, seed: int, design: dict = DESIGN):
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0], "a smoke run on a tiny design")
     ap.add_argument("--out", type=Path, default=Path("hatton-run"))
     ap.add_argument("--table", type=Path, default=TABLE)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--quick", action="store_true", help="a smoke run on a tiny design")
     args = ap.parse_args(argv)
     if args.quick:
         with tempfile.TemporaryDirectory(prefix="suds-hatton-quick-") as tmp:

@@ -26,7 +26,6 @@ With ``--db`` instead of ``--seeds`` nothing is simulated or run: the campaign i
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import tempfile
@@ -35,6 +34,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from benchmarks._harness import script_parser
 from suds_exp.analysis.findings import (
     findings,
     findings_display,
@@ -69,7 +69,9 @@ def prepare(db: Path, seed: int, effects: list[str] = (), config: Path | None = 
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = script_parser(
+        __doc__.split("\n")[0], "a smoke run: the table of 2 synthetic draws a pair"
+    )
     parser.add_argument("--db", type=Path, help="read --campaign from this database")
     parser.add_argument("--seeds", help="dataset seeds to simulate, e.g. 0,1,2")
     parser.add_argument("--out", type=Path, default=Path("bench-findings"))
@@ -88,9 +90,6 @@ def main(argv=None) -> None:
     )
     parser.add_argument(
         "--config", type=Path, help="simulator config file of the robot (default nominal)"
-    )
-    parser.add_argument(
-        "--quick", action="store_true", help="a smoke run: the table of 2 synthetic draws a pair"
     )
     args = parser.parse_args(argv)
     if args.quick:

@@ -14,19 +14,19 @@ Run: .venv/bin/python -m benchmarks.studies.gait_ceiling [--bound 1.3] [--order 
 
 from __future__ import annotations
 
-import argparse
 import time
 
 import numpy as np
 from scipy.optimize import minimize
 
+from benchmarks._harness import script_parser
 from suds_exp.gait.design import circle
 from suds_exp.gait.shape import FourierGait, paper_gaits, within_bound
 from suds_exp.gait.truth import simulate_forward
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
     ap.add_argument("--order", type=int, default=2, help="Fourier harmonics per joint")
     ap.add_argument("--evals", type=int, default=150, help="simulations per local search")
@@ -34,7 +34,6 @@ def main(argv=None) -> None:
     ap.add_argument("--starts", type=int, default=3, help="local searches from the best")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--freq", type=float, default=0.5, help="Hz")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     if args.quick:
         args.order, args.evals, args.random, args.starts = 1, 5, 3, 1

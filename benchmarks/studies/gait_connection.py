@@ -22,7 +22,6 @@ Run: .venv/bin/python -m benchmarks.studies.gait_connection [--extra]
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -30,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks._data import QUICK_DESIGN
+from benchmarks._harness import script_parser
 from suds_exp.gait.connection import compare_connections, learned_connection
 from suds_exp.gait.plots import draw_connection
 from suds_exp.gait.predict import decimate, fit_map
@@ -93,12 +93,11 @@ def at_data_directions(model, samples, n: int = 2000, seed: int = 0) -> np.ndarr
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--extra", action="store_true", help="add the extra gaits")
     ap.add_argument("--grid", type=int, default=41)
     ap.add_argument("--range", type=float, default=2.0, dest="half_range")
     ap.add_argument("--out", type=Path, default=Path("reports/gait-connection"))
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     design = {}
     if args.quick:

@@ -24,7 +24,6 @@ Run: .venv/bin/python -m benchmarks.studies.gait_predict [--learner GMR] [--seed
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -33,6 +32,7 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from benchmarks._data import QUICK_DESIGN, simulated_database
+from benchmarks._harness import script_parser
 from suds_exp.gait.predict import bootstrap_draws, decimate, fit_map
 from suds_exp.gait.shape import paper_gaits
 from suds_exp.gait.support import Support
@@ -53,11 +53,10 @@ def scores(pred: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--learner", default="GMR")
     ap.add_argument("--seed", type=int, default=0, help="dataset seed")
     ap.add_argument("--boot", type=int, default=0, help="refits on resampled trials")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     started, cpu = time.perf_counter(), time.process_time()
     with tempfile.TemporaryDirectory(prefix="suds-gait-predict-") as tmp:

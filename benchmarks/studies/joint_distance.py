@@ -13,11 +13,11 @@ design.
 
 from __future__ import annotations
 
-import argparse
 import json
 import tempfile
 from pathlib import Path
 
+from benchmarks._harness import script_parser
 from suds_exp.preprocess import preprocess
 from suds_exp.preprocess.truth import truth_errors
 from suds_exp.robot import GAITS
@@ -57,9 +57,8 @@ def row(folder: Path, name: str, design: dict, seed: int) -> str:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = script_parser(__doc__.split("\n\n")[0], "a smoke run: gait O, seed 0")
     ap.add_argument("--seeds", default="0,1", help="dataset seeds, comma-separated")
-    ap.add_argument("--quick", action="store_true", help="a smoke run: gait O, seed 0")
     args = ap.parse_args(argv)
     designs = {"O": DESIGNS["O"]} if args.quick else DESIGNS
     seeds = [0] if args.quick else [int(s) for s in args.seeds.split(",")]

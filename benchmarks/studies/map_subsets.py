@@ -12,7 +12,6 @@ Run: .venv/bin/python -m benchmarks.studies.map_subsets [--seed 0] [--out /tmp/m
 
 from __future__ import annotations
 
-import argparse
 import atexit
 import shutil
 import tempfile
@@ -20,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks._harness import script_parser
 from suds_exp.gait.predict import fit_map
 from suds_exp.ingest import ingest_paths
 from suds_exp.plan import Target, TargetTruth
@@ -34,10 +34,9 @@ NEAR = ["O", "D-", "S-"]
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0], "a smoke run: 4-cycle trials, 1 repeat")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", type=Path, default=Path("/tmp/map_subsets"))
-    ap.add_argument("--quick", action="store_true", help="a smoke run: 4-cycle trials, 1 repeat")
     args = ap.parse_args(argv)
     cycles, repeats = (10, 10), (1, 2)
     if args.quick:

@@ -30,7 +30,6 @@ momentum diagnostic's time constants and verdict.
 
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
 import sys
@@ -40,7 +39,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from benchmarks._harness import ROOT
+from benchmarks._harness import ROOT, script_parser
 from suds_exp.analysis.formatting import to_markdown
 
 N_BOOT = 2000
@@ -293,7 +292,7 @@ def tau_profile(db: Path) -> pd.DataFrame:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = script_parser(__doc__.split("\n\n")[0], "a smoke run: tau 0, one draw")
     ap.add_argument("--out", type=Path, help="the databases' folder (required unless --quick)")
     ap.add_argument("--taus", default="0,0.1,0.25,0.5")
     ap.add_argument("--ratios", default="1,1.5,2.5")
@@ -302,7 +301,6 @@ def main(argv=None) -> None:
     ap.add_argument("--synthetic", action="store_true", help="the synthetic Finsler swimmer")
     ap.add_argument("--snake", type=Path, help="refdata folder: the flying snake, GMR vs GMR+P")
     ap.add_argument("--why-tau", metavar="TAU", help="GMR+P's time constants against the truth")
-    ap.add_argument("--quick", action="store_true", help="a smoke run: tau 0, one draw")
     ap.add_argument("--prep-param", action="append", default=[], metavar="KEY=VALUE",
                     help="a preprocessing parameter for every dataset (repeatable)")  # fmt: skip
     args = ap.parse_args(argv)

@@ -23,13 +23,13 @@ the median seconds of one partial_fit of one cycle and its ratio to the cycle's 
 
 from __future__ import annotations
 
-import argparse
 import json
 import time
 
 import numpy as np
 import pandas as pd
 
+from benchmarks._harness import script_parser
 from suds_exp.sim.schedule import parse_change
 from suds_exp.stream import StreamSettings, run_trial, simulate_stream_samples, summarise
 
@@ -45,14 +45,13 @@ def noisy(samples: pd.DataFrame, seed: int) -> pd.DataFrame:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--change", default="flippers=locked@30s")
     ap.add_argument("--cycles", type=int, default=60)
     ap.add_argument("--freq", type=float, default=1.0)
     ap.add_argument("--models", default="GMR,OnlineGMR,GMR+SUDS,OnlineGMR+SUDS")
     ap.add_argument("--json", action="store_true", help="also print the summary as JSON")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     if args.quick:
         args.seeds, args.cycles, args.models = 1, 40, "GMR,OnlineGMR"

@@ -22,7 +22,6 @@ its own constant term, can be read off.
 
 from __future__ import annotations
 
-import argparse
 import itertools
 import tempfile
 from pathlib import Path
@@ -31,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from benchmarks._data import QUICK_DESIGN, simulated_database
+from benchmarks._harness import script_parser
 from suds_exp.models import make_model
 from suds_exp.preprocess import get_version
 from suds_exp.store import Store
@@ -70,11 +70,10 @@ def compare(samples: pd.DataFrame, orders: list[int]) -> pd.DataFrame:
 
 
 def main(argv=None) -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script_parser(__doc__.splitlines()[0], "a smoke run on a tiny simulated dataset")
     p.add_argument("--db", default="suds.duckdb")
     p.add_argument("--prep", default="v1")
     p.add_argument("--orders", default="5,6,8,10,12", help="Fourier orders, comma list")
-    p.add_argument("--quick", action="store_true", help="a smoke run on a tiny simulated dataset")
     args = p.parse_args(argv)
     if args.quick:
         with tempfile.TemporaryDirectory(prefix="suds-phase-only-") as tmp:

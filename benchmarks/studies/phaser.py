@@ -31,7 +31,6 @@ reference's ``Phaser`` class. Without it only our error to the truth is printed.
 
 from __future__ import annotations
 
-import argparse
 import json
 import tempfile
 import warnings
@@ -40,6 +39,7 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from benchmarks._harness import script_parser
 from suds_exp.commands.simulate import simulate_command
 from suds_exp.preprocess import Phaser, load_samples, preprocess
 from suds_exp.preprocess.truth import truth_path
@@ -169,11 +169,10 @@ def relaxation_cases(seed: int) -> dict[str, dict]:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = script_parser(__doc__.split("\n\n")[0], "a smoke run: the 1 Hz trials")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--reference", help="Python file defining ReferencePhaser (see above)")
-    parser.add_argument("--quick", action="store_true", help="a smoke run: the 1 Hz trials")
     args = parser.parse_args(argv)
     global REFERENCE
     REFERENCE = load_reference(args.reference) if args.reference else None

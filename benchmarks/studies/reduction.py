@@ -22,7 +22,6 @@ error with PCA, with a 95 % bootstrap interval (draws resampled).
 
 from __future__ import annotations
 
-import argparse
 import shutil
 import tempfile
 from pathlib import Path
@@ -31,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from benchmarks._data import QUICK_DESIGN, simulated_database
+from benchmarks._harness import script_parser
 from suds_exp.analysis.queries import load_results
 from suds_exp.campaign import run_campaign
 from suds_exp.commands.campaign import parse_campaign_options
@@ -57,7 +57,7 @@ def paired_ratio(a: np.ndarray, b: np.ndarray, n_boot: int = 2000, seed: int = 0
 
 
 def main(argv=None) -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script_parser(__doc__.splitlines()[0], "a smoke run on a tiny simulated dataset")
     p.add_argument("--db", help="a database with the dataset (required unless --quick)")
     p.add_argument("--reductions", default="pca,kernel-pca,autoencoder")
     p.add_argument("--models", default="TLS+SUDS,GMR+SUDS,GMR")
@@ -65,7 +65,6 @@ def main(argv=None) -> None:
     p.add_argument("--boots", type=int, default=4)
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--train-cycles", type=int, default=30)
-    p.add_argument("--quick", action="store_true", help="a smoke run on a tiny simulated dataset")
     args = p.parse_args(argv)
     if args.quick:
         with tempfile.TemporaryDirectory(prefix="suds-reduction-") as tmp:

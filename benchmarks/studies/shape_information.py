@@ -32,7 +32,6 @@ robot of ``--config`` (default nominal) with the effects of ``--set``.
 
 from __future__ import annotations
 
-import argparse
 import itertools
 import tempfile
 from fractions import Fraction
@@ -40,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks._harness import script_parser
 from suds_exp.ingest import ingest_paths
 from suds_exp.models import fourier
 from suds_exp.preprocess import get_version, preprocess
@@ -137,7 +137,7 @@ def pipeline(cfg: SimConfig, seed: int, order: int) -> dict[str, float]:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0])
     ap.add_argument("--gait", default="O")
     ap.add_argument("--freqs", default="1/3,1", help="Hz, comma list (fractions allowed)")
     ap.add_argument("--repeats", type=int, default=4)
@@ -153,7 +153,6 @@ def main(argv=None) -> None:
     ap.add_argument("--set", nargs="*", default=[], help="effects, EFFECT.PARAM=VALUE")
     ap.add_argument("--springs", default="", help="hinge springs to sweep, N mm/rad")
     ap.add_argument("--pipeline", action="store_true", help="the whole design, preprocessed")
-    ap.add_argument("--quick", action="store_true", help="a smoke run at tiny sizes")
     args = ap.parse_args(argv)
     if args.quick:
         args.freqs, args.repeats, args.pipeline, args.springs = "1", 2, False, ""

@@ -36,7 +36,6 @@ cannot supply.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import tempfile
 from pathlib import Path
@@ -45,6 +44,7 @@ import numpy as np
 import pandas as pd
 
 from benchmarks._data import decimated, ensure_data
+from benchmarks._harness import script_parser
 from suds_exp.analysis.queries import load_results
 from suds_exp.analysis.survey import (
     SURVEY_COLUMNS,
@@ -70,7 +70,7 @@ def all_conditions(store: Store, spec: str | None = None) -> list[str]:
 
 
 def main(argv=None) -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script_parser(__doc__.splitlines()[0], "a smoke run: O at 1 Hz, 4 learners")
     p.add_argument("--db", default="survey.duckdb")
     p.add_argument("--gaits", default="S+,S-,O,D-,D+")
     p.add_argument("--boots", type=int, default=4)
@@ -83,7 +83,6 @@ def main(argv=None) -> None:
     p.add_argument("--per-condition", action="store_true")
     p.add_argument("--skip-infeasible", action="store_true")
     p.add_argument("--prep", default="v1")
-    p.add_argument("--quick", action="store_true", help="a smoke run: O at 1 Hz, 4 learners")
     args = p.parse_args(argv)
     if args.quick:
         with tempfile.TemporaryDirectory(prefix="suds-survey-quick-") as tmp:

@@ -31,7 +31,6 @@ without refitting (``--jobs 0``: only print).
 
 from __future__ import annotations
 
-import argparse
 import sys
 import tempfile
 import time
@@ -41,20 +40,9 @@ from pathlib import Path
 import pandas as pd
 
 from benchmarks._data import decimated, ensure_data
+from benchmarks._harness import script_parser
+from suds_exp.models.baselines import JUDGED_RECIPES
 
-#: The survey's earlier recipe ("old"), every setting a candidate changes
-#: pinned, so the reference does not move with the defaults; candidates change it.
-OLD_RECIPES = {
-    "MLP": {"hidden_layer_sizes": [64, 64], "max_iter": 200, "tol": 1e-4},
-    "GBT": {
-        "max_iter": 200,
-        "learning_rate": 0.1,
-        "max_leaf_nodes": 31,
-        "max_bins": 255,
-        "n_iter_no_change": 10,
-    },
-    "KRR": {"n_components": 300},
-}
 CANDIDATES = {
     "MLP": {
         "max_iter=100": {"max_iter": 100},
@@ -82,7 +70,7 @@ def recipes(which: str) -> list[tuple[str, str, dict]]:
     """(learner, recipe label, parameters) to run; GMR once as the headline's reference."""
     out = [("GMR", "old", {})]
     for learner in LEARNERS:
-        old = OLD_RECIPES[base_of(learner)]
+        old = JUDGED_RECIPES[base_of(learner)]  # the "old" recipe: what candidates change
         out.append((learner, "old", dict(old)))
         if which == "all":
             for label, params in CANDIDATES[base_of(learner)].items():
@@ -223,7 +211,7 @@ def headline(rows: pd.DataFrame, n_boot: int) -> pd.DataFrame:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = script_parser(__doc__.splitlines()[0], "a smoke run: O at 1 Hz, GMR and MLP")
     ap.add_argument("--db", default="tolerance.duckdb")
     ap.add_argument("--gaits", default="O")
     ap.add_argument("--conditions", default="O@0.5,O@1")
@@ -235,7 +223,6 @@ def main(argv=None) -> int:
     ap.add_argument("--rows", default="tolerance_rows.csv")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--n-boot", type=int, default=1000)
-    ap.add_argument("--quick", action="store_true", help="a smoke run: O at 1 Hz, GMR and MLP")
     a = ap.parse_args(argv)
     if a.quick:
         with tempfile.TemporaryDirectory(prefix="suds-tolerance-quick-") as tmp:

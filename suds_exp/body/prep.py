@@ -33,7 +33,7 @@ from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.params import DEFAULTS, params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.pipeline import PLANAR_Z, PrepResult, new_result, preprocess
+from suds_exp.preprocess.pipeline import PLANAR_Z, new_result, preprocess
 from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
@@ -42,6 +42,7 @@ from suds_exp.preprocess.tables import (
 )
 from suds_exp.preprocess.version import (
     NewFit,
+    PrepResult,
     find_version,
     stored_progress,
     write_trials,

@@ -9,9 +9,15 @@ from suds_exp.preprocess.params import (
     resolve_params,
 )
 from suds_exp.preprocess.phaser import Phaser
-from suds_exp.preprocess.pipeline import PrepResult, preprocess
+from suds_exp.preprocess.pipeline import preprocess
 from suds_exp.preprocess.rates import Differentiator
-from suds_exp.preprocess.version import Version, get_version, list_versions, load_samples
+from suds_exp.preprocess.version import (
+    PrepResult,
+    Version,
+    get_version,
+    list_versions,
+    load_samples,
+)
 from suds_exp.robot import sample_columns
 
 __all__ = [

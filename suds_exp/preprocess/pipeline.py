@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -32,6 +32,7 @@ from suds_exp.preprocess.reduction import passive_reducer
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.version import (
     NewFit,
+    PrepResult,
     find_version,
     kept_ratio,
     stored_progress,
@@ -49,36 +50,6 @@ PLANAR_Z = "CASE WHEN missing THEN z ELSE coalesce(z, 0) END"
 #: Trials are written in batches of about this many frames, one transaction each (fewer
 #: transactions are faster; a batch is what an interrupted run may have to redo).
 WRITE_BATCH_FRAMES = 50_000
-
-
-@dataclass
-class PrepResult:
-    """What a `preprocess` run did.
-
-    ``processed``/``skipped``: trial ids written now / already done before;
-    ``explained_variance_ratio``: of the k kept passive components (fraction each);
-    ``interpolated_pose_frames``: frames of a segment, summed over segments and the
-    trials processed now, whose pose came from interpolated tracks because too few of
-    its markers were seen (a segment body's; the swimmer's pipeline reports none);
-    ``warnings``: one line per fit of this run the trials did not pin down (e.g. the
-    segment origins), for the command layer to show.
-    """
-
-    version_id: int
-    name: str
-    params_hash: str
-    params: dict
-    created: bool
-    processed: list[int] = field(default_factory=list)
-    skipped: list[int] = field(default_factory=list)
-    explained_variance_ratio: list[float] = field(default_factory=list)
-    n_samples: int = 0
-    interpolated_pose_frames: int = 0
-    seconds: float = 0.0
-    warnings: list[str] = field(default_factory=list)
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 @dataclass

@@ -1,5 +1,6 @@
 """A stored preprocessing version as one object: `get_version(store, ref) -> Version`;
-and the writers that create a version and store its fits and samples.
+and the writers that create a version and store its fits and samples, recording what
+they did in the run's `PrepResult`.
 
 The one way into the ``prep_*`` tables for code outside preprocessing: campaign,
 discrepancy and the truth comparison find a version, its fitted state and its samples
@@ -12,7 +13,7 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -29,8 +30,35 @@ from suds_exp.preprocess.tables import prep_fits, prep_pca, prep_trials, prep_ve
 from suds_exp.robot import sample_columns
 from suds_exp.store import Store
 
-if TYPE_CHECKING:  # the run's result type; the pipeline imports this module
-    from suds_exp.preprocess.pipeline import PrepResult
+
+@dataclass
+class PrepResult:
+    """What a `preprocess` run did.
+
+    ``processed``/``skipped``: trial ids written now / already done before;
+    ``explained_variance_ratio``: of the k kept passive components (fraction each);
+    ``interpolated_pose_frames``: frames of a segment, summed over segments and the
+    trials processed now, whose pose came from interpolated tracks because too few of
+    its markers were seen (a segment body's; the swimmer's pipeline reports none);
+    ``warnings``: one line per fit of this run the trials did not pin down (e.g. the
+    segment origins), for the command layer to show.
+    """
+
+    version_id: int
+    name: str
+    params_hash: str
+    params: dict
+    created: bool
+    processed: list[int] = field(default_factory=list)
+    skipped: list[int] = field(default_factory=list)
+    explained_variance_ratio: list[float] = field(default_factory=list)
+    n_samples: int = 0
+    interpolated_pose_frames: int = 0
+    seconds: float = 0.0
+    warnings: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
 
 
 @dataclass(repr=False)

@@ -4,7 +4,7 @@ The elements' positions and velocities for a shape and its rate (`element_geomet
 each element's drag (Maladen et al. 2009, smoothed sign functions) and its derivative,
 and the residual and analytic Jacobian of the 3 body balances and 4 hinge balances
 (`assemble`) that `sim/rft.py` solves. Units are the solver's scaled ones (see rft.py);
-the packed parameters' indices ``P_*`` are laid out by `sim/effect_params.py` from the
+the packed parameters' indices ``P_*`` are laid out by `sim/kernel_params.py` from the
 slots the simulator's effects declare.
 """
 
@@ -13,7 +13,8 @@ from __future__ import annotations
 import math
 
 from suds_exp.sim._jit import njit
-from suds_exp.sim.effect_params import FlippersEffect, kernel_layout
+from suds_exp.sim.effect_params import FlippersEffect
+from suds_exp.sim.kernel_params import kernel_layout
 
 # the packed parameters' indices, from the slots the simulator's effects declare
 _SLOT = {k: i for k, (i, _) in kernel_layout().items()}

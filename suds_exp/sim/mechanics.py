@@ -15,7 +15,7 @@ from suds_exp.errors import ConfigError
 from suds_exp.sim import rft
 from suds_exp.sim.bed import draw_bed, draw_grains
 from suds_exp.sim.config import SimConfig
-from suds_exp.sim.effect_params import kernel_layout, kernel_values
+from suds_exp.sim.kernel_params import kernel_layout, kernel_values
 
 
 @dataclass(frozen=True)
@@ -101,7 +101,7 @@ def element_table(cfg: SimConfig) -> ElementTable:
 
 def pack_params(cfg: SimConfig) -> np.ndarray:
     """Kernel parameter vector (n_params,) of one configuration (scaled units), laid out
-    by `effect_params.kernel_layout` (the solver's ``P_*`` indices)."""
+    by `kernel_params.kernel_layout` (the solver's ``P_*`` indices)."""
     layout = kernel_layout()
     p = np.zeros(sum(n for _, n in layout.values()))
     for key, value in kernel_values(cfg).items():

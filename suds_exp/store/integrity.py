@@ -18,8 +18,8 @@ Every open checks the headers, reads the free list and checks that the file is l
 enough for every block in use (a few KiB read: a truncated copy is refused). When the
 file's size or modification time is not what this process left it at, every block in
 use has its checksum checked too, vectorised with NumPy: 0.4-0.5 s for a 280 MB file
-on this project's machine (``tests/reliability_probe.py`` measures it), against ~1 s to
-import the library. So a command checks each block once, and a long campaign does not
+on this project's machine (``suds_exp.testing.reliability_probe`` measures it), against
+~1 s to import the library. So a command checks each block once, and a long campaign does not
 re-check after each of its own writes. Free blocks and blocks past ``block_count``
 (left by a checkpoint a crash cut short) are not checked: DuckDB does not read them.
 Files of a storage format this module does not know (`KNOWN_FORMATS`) or encrypted ones

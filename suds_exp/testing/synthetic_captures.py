@@ -157,6 +157,10 @@ def _capture_errors(xyz, rng, noise_mm, tilt_rad, n_jumps, n_dropouts):
     return xyz, jumped, dropped
 
 
+#: Each gait once, at a frequency of its own (Hz): a mix of gaits and rates.
+ONE_PER_GAIT = (("O", 0.5), ("D+", 1.0), ("S+", 1 / 3), ("D-", 0.5), ("S-", 1.0))
+
+
 def synthetic_trial(
     gait: str = "O",
     frequency_hz: float = 0.5,
@@ -191,6 +195,12 @@ def synthetic_trial(
         }
     )
     return SyntheticTrial(gait, frequency_hz, rate_hz, xyz, truth, jumped, dropped)
+
+
+def synthetic_trials(conditions=ONE_PER_GAIT, seed: int = 0, **settings) -> list[SyntheticTrial]:
+    """`synthetic_trial` of each (gait, frequency Hz) of ``conditions``, seeded ``seed``,
+    ``seed + 1``, ...; ``settings``: its others (``n_cycles``, ``noise_mm``, ...)."""
+    return [synthetic_trial(g, f, seed=seed + i, **settings) for i, (g, f) in enumerate(conditions)]
 
 
 def write_marker_csv(trial: SyntheticTrial, path: Path) -> Path:

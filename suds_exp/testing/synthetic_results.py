@@ -1,4 +1,5 @@
-"""Synthetic ``results`` rows with effects of known size, for tests, benchmarks and demos.
+"""Synthetic ``results`` rows with effects of known size, for tests, benchmarks and demos
+(and `finished_rows`: rows that stand for a finished campaign).
 
 Each learner result's ``100 ln(rmse_vx)`` is a sum of planted GLM coefficients (named as
 the GLM table names its terms), a power law in the number of training cycles, and
@@ -127,6 +128,51 @@ def synthetic_results(
     grid["rmse_vx"] = np.exp(y / 100.0)
     _fill_bookkeeping(grid, campaign, rng)
     return grid.drop(columns="_steps")
+
+
+def finished_rows(keys, campaign: str, n_cycles: int, rmse_vx=1.0) -> pd.DataFrame:
+    """One stored-looking ``results`` row for each job of ``keys`` as if it had run (no
+    learner runs): to stand for a finished campaign, as when resuming one.
+
+    Parameters
+    ----------
+    keys : sequence of (draw, model name)
+        A draw as `suds_exp.campaign.Draw`: ``train`` and ``test`` (gait, frequency Hz)
+        and ``boot``.
+    campaign : str
+    n_cycles : int
+        Training cycles of every job (its ranges span that many cycles).
+    rmse_vx : float or array of one per key
+        mm/s; the other errors, the trials and the timings are constants.
+
+    Returns
+    -------
+    DataFrame with the ``results`` columns (select ``RESULT_COLUMNS`` for their order).
+    """
+    return pd.DataFrame(
+        {
+            "campaign": campaign,
+            "model": [m for _, m in keys],
+            "train_gait": [d.train[0] for d, _ in keys],
+            "train_frequency_hz": [d.train[1] for d, _ in keys],
+            "test_gait": [d.test[0] for d, _ in keys],
+            "test_frequency_hz": [d.test[1] for d, _ in keys],
+            "boot": [d.boot for d, _ in keys],
+            "n_cycles": n_cycles,
+            "train_trials": "[1]",
+            "train_ranges": f"[[1, 0, {n_cycles - 1}]]",
+            "test_trial": 2,
+            "test_range": f"[0, {n_cycles - 1}]",
+            "rmse_vx": rmse_vx,
+            "rmse_vy": 1.0,
+            "rmse_wz": 0.1,
+            "n_test": 100,
+            "fit_seconds": 0.1,
+            "predict_seconds": 0.01,
+            "finished_at": pd.Timestamp("2026-01-01"),
+            "error": None,
+        }
+    )
 
 
 def _job_grid(models, n_cycles, n_boot: int) -> pd.DataFrame:

@@ -1,6 +1,6 @@
 """The tables and views the migration files create, read from their SQL text in order, so
-independently of the migration runner (used by tests/test_packaging.py and by
-.ci/wheel_check.sh against an installed wheel)."""
+independently of the migration runner (`suds_exp.store.migrate`), whose result it checks:
+tests/test_packaging.py in a checkout, .ci/wheel_check.sh against an installed wheel."""
 
 import re
 from pathlib import Path

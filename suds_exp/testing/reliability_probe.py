@@ -19,8 +19,11 @@ of 12 cycles) and counts:
   unwritable report and plot folders: one line, status 2, the database file byte-identical;
 - the cost of the integrity check on a large file.
 
-    python -m tests.reliability_probe            # the long version (~15 min on 2 cores)
-    python -m tests.reliability_probe --quick    # one moment / offset each (~4 min)
+    python -m suds_exp.testing.reliability_probe            # the long version (~15 min on 2 cores)
+    python -m suds_exp.testing.reliability_probe --quick    # one moment / offset each (~4 min)
+
+`tests/test_reliability.py` runs its cases in parts. It drives the command line only, so it
+sits in this box although the commands it runs reach every box above it.
 """
 
 from __future__ import annotations
@@ -44,9 +47,14 @@ from pathlib import Path
 import duckdb
 import pandas as pd
 
-REPO = Path(__file__).resolve().parents[1]
-
-CLI = [sys.executable, str(REPO / "cli.py")]
+#: The command line of the suds_exp this module belongs to (a checkout's cli.py, an
+#: installed wheel's app), whatever folder a command runs in: `ENV` puts that package first.
+CLI = [sys.executable, "-m", "suds_exp"]
+_TOP = str(Path(__file__).resolve().parents[2])
+ENV = {
+    **os.environ,
+    "PYTHONPATH": os.pathsep.join(filter(None, [_TOP, os.environ.get("PYTHONPATH")])),
+}
 #: Columns that differ between two runs of the same work (clock, pid, timing).
 VOLATILE = {
     "created_at",
@@ -121,21 +129,23 @@ class Data:
 
 
 def build(work: Path) -> Data:
-    """Write the synthetic captures and the ingested / preprocessed databases."""
-    from suds_exp.ingest import ingest_paths
-    from suds_exp.preprocess import preprocess
-    from suds_exp.store import Store
+    """Write the synthetic captures and the ingested / preprocessed databases (through the
+    command line, as a user would)."""
     from suds_exp.testing.synthetic_captures import write_dataset
 
     manifest = write_dataset(
         work / "captures", gaits=("O", "S+"), frequencies=(1.0,), repeats=2, n_cycles=12
     )
-    ingested = work / "ingested.duckdb"
-    ingest_paths(Store(ingested), [manifest.parent], manifest, progress=False)
-    prepped = work / "prepped.duckdb"
+    ingested, prepped = work / "ingested.duckdb", work / "prepped.duckdb"
+    _done(run(["ingest", str(manifest.parent), "--manifest", str(manifest)], ingested, work))
     shutil.copy(ingested, prepped)
-    preprocess(Store(prepped), "v1", progress=False)
+    _done(run(["preprocess", "--name", "v1"], prepped, work))
     return Data(work, manifest.parent, manifest, ingested, prepped)
+
+
+def _done(outcome: Outcome) -> None:
+    if outcome.code != 0:
+        raise RuntimeError(f"building the probe's data failed: {outcome.stderr[-500:]}")
 
 
 # -- running commands -----------------------------------------------------------------------
@@ -162,6 +172,7 @@ def start(args: list[str], db: Path, cwd: Path) -> subprocess.Popen:
     return subprocess.Popen(
         [*CLI, *args, "--db", str(db), "-q"] if _quiet(args) else [*CLI, *args, "--db", str(db)],
         cwd=cwd,
+        env=ENV,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
