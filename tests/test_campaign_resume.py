@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import tracemalloc
-from datetime import datetime
 
 import pandas as pd
 import pytest
@@ -12,6 +11,7 @@ from suds_exp.campaign import CampaignOptions, enumerate_draws, run_campaign
 from suds_exp.campaign.bank import rounded_conditions
 from suds_exp.campaign.job import RESULT_COLUMNS
 from suds_exp.store import Store
+from suds_exp.testing import synthetic_results
 from suds_exp.testing.synthetic_samples import synthetic_samples
 
 MODELS = ["phase-only", "TLS"]
@@ -26,30 +26,7 @@ def finished_rows(samples: pd.DataFrame, campaign: str, boots: int) -> pd.DataFr
     """One stored-looking row for every job of the campaign's grid (no learner runs)."""
     have = rounded_conditions(samples)
     keys = [(d, m) for d in enumerate_draws(campaign, have, have, boots, 4, []) for m in MODELS]
-    return pd.DataFrame(
-        {
-            "campaign": campaign,
-            "model": [m for _, m in keys],
-            "train_gait": [d.train[0] for d, _ in keys],
-            "train_frequency_hz": [d.train[1] for d, _ in keys],
-            "test_gait": [d.test[0] for d, _ in keys],
-            "test_frequency_hz": [d.test[1] for d, _ in keys],
-            "boot": [d.boot for d, _ in keys],
-            "n_cycles": 4,
-            "train_trials": "[1]",
-            "train_ranges": "[[1, 0, 3]]",
-            "test_trial": 2,
-            "test_range": "[0, 3]",
-            "rmse_vx": 1.0,
-            "rmse_vy": 1.0,
-            "rmse_wz": 0.1,
-            "n_test": 100,
-            "fit_seconds": 0.1,
-            "predict_seconds": 0.01,
-            "finished_at": datetime(2026, 1, 1),
-            "error": None,
-        }
-    )[list(RESULT_COLUMNS)]
+    return synthetic_results.finished_rows(keys, campaign, 4)[list(RESULT_COLUMNS)]
 
 
 def resume_peak(store: Store, campaign: str, samples: pd.DataFrame):

@@ -443,7 +443,7 @@ def probe_ctrl_c(data: Data) -> Tally:
 def ctrl_c(p: subprocess.Popen, started: float, again_s: float = 3.0) -> tuple[Outcome, int]:
     """SIGINT to ``p``'s process group, as a terminal's Ctrl-C; pressed again when the
     process still runs ``again_s`` s later (a Ctrl-C while workers start may be lost:
-    see `suds_exp.campaign.runner._sigint_blocked`). Returns the outcome and the presses."""
+    see `suds_exp.campaign.signals.sigint_blocked`). Returns the outcome and the presses."""
     presses = 0
     while True:
         os.killpg(p.pid, signal.SIGINT)
