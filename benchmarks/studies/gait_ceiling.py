@@ -16,6 +16,8 @@ measured against, so it is a global search made hard to beat:
 
 It prints the best gait, its displacement, the simulations it took, the best of the runs
 that started from random gaits alone, and whether the ceiling exceeds every `KNOWN` gait.
+The displacement is per cycle and the simulator is rate independent, so at order >= 2 the
+best gait traces its loop more than once a cycle (docs/results/adaptive.md).
 
 Run: .venv/bin/python -m benchmarks.studies.gait_ceiling [--bound 1.3] [--budget 12000] [--seed 0]
 """
