@@ -22,10 +22,10 @@ exactly (`suds_exp.gait.truth`): the gait-goal curve is that forward displacemen
 cycle against cycles recorded, as a share of --ceiling (mm per cycle, the global search of
 `benchmarks/studies/gait_ceiling.py`: 146.3, the best of its seeds 0 and 1, a gait that
 runs its loop twice a cycle; see docs/results/adaptive.md). The best gait of a learning
-arm is the recorded gait its map predicts best; of BO, the best evaluation. The map-goal curve (--map-budget > 0) is
-GMR's error on the fixed unseen gaits of `suds_exp.plan.unseen_gaits` (RMS distance of
-predicted from simulated net displacement per cycle, mm) for grid, random and the
-plan loop with --goal map.
+arm is the recorded gait its map predicts best; of BO, the best evaluation. The map-goal
+curve (--map-budget > 0) is GMR's error on the fixed unseen gaits of
+`suds_exp.plan.unseen_gaits` (RMS distance of predicted from simulated net displacement
+per cycle, mm) for grid, random and the plan loop with --goal map.
 
 Each dataset seed's gait-goal arms are run several times (--repeats for plan and random,
 --peer-repeats for bo and tpe; grid and designer have no randomness of their own): run r's
