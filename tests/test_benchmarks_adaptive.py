@@ -2,7 +2,16 @@
 runs a dataset seed, summarised by medians that count a run that never reached a level as
 beyond any budget, and the plan loop's ratio of medians to each peer's."""
 
-from benchmarks.studies.adaptive import job_seed, over_runs, ratios, run_stats
+import pandas as pd
+
+from benchmarks.studies.adaptive import (
+    job_seed,
+    over_runs,
+    ratios,
+    read_curves,
+    run_stats,
+    summary_from_curves,
+)
 
 
 def _runs(to80, to90):
@@ -43,3 +52,45 @@ def test_repeat_zero_is_the_dataset_seed_and_later_runs_draw_their_own():
     seeds = {job_seed(arm, s, r) for arm in ("plan", "bo") for s in (0, 1) for r in (1, 2)}
     assert len(seeds) == 8 and seeds.isdisjoint({0, 1})
     assert job_seed("bo", 1, 2) == job_seed("bo", 1, 2)
+
+
+def _curve(arm, seed, repeat, cycles, best):
+    return [
+        {"goal": "gait", "arm": arm, "seed": seed, "repeat": repeat, "cycles": c,
+         "best_forward_mm": b}
+        for c, b in zip(cycles, best, strict=True)
+    ]  # fmt: skip
+
+
+def test_the_summary_is_recomputed_from_stored_curves_against_another_ceiling():
+    frame = pd.DataFrame(
+        _curve("plan", 0, 0, [5, 10, 15], [40.0, 58.0, 66.0])
+        + _curve("plan", 0, 1, [5, 10, 15], [30.0, 50.0, 52.0])
+        + _curve("plan", 0, 2, [5, 10, 15], [61.0, 61.0, 61.0])
+        + _curve("bo", 0, 0, [5, 10, 15, 20], [10.0, 20.0, 55.0, 70.0])
+    )
+    low = summary_from_curves(frame, ceiling=64.0, budget=15, peer_budget=20)
+    # 80 % of 64 is 51.2, 90 % 57.6: the runs reach them at 10, 15, 5 and 10, never, 5
+    assert low["arms"]["plan"]["0"]["cycles_to_80"]["runs"] == [10, 15, 5]
+    assert low["arms"]["plan"]["0"]["cycles_to_90"]["runs"] == [10, None, 5]
+    high = summary_from_curves(frame, ceiling=80.0, budget=15, peer_budget=20)
+    # 80 % of 80 is 64: only run 0 reaches it; 90 % (72) nobody: the median is beyond
+    assert high["arms"]["plan"]["0"]["cycles_to_80"]["runs"] == [15, None, None]
+    assert high["arms"]["plan"]["0"]["cycles_to_90"]["median"] is None
+    # BO is read at the loop's budget too: its best within 15 cycles is 55 of 80
+    assert high["arms"]["bo"]["0"]["median_share_at_budget"] == round(55 / 80, 3)
+    assert high["arms"]["bo"]["0"]["median_share_of_ceiling"] == round(70 / 80, 3)
+    # the loop's median run never reached 80 % of 80 (BO did, at 20): no ratio
+    assert high["arms"]["bo"]["0"]["cycles_to_80"]["median"] == 20
+    assert high["ratios"]["bo"]["0"]["80"] == {"ratio": None, "peer_missed": False}
+
+
+def test_a_later_curves_file_replaces_an_earlier_ones_runs_of_the_same_arm_and_seed(tmp_path):
+    first, second = tmp_path / "a.csv", tmp_path / "b.csv"
+    pd.DataFrame(_curve("bo", 1, 0, [5], [10.0]) + _curve("plan", 1, 0, [5], [20.0])).to_csv(
+        first, index=False
+    )
+    pd.DataFrame(_curve("bo", 1, 0, [5, 300], [10.0, 80.0])).to_csv(second, index=False)
+    frame = read_curves([first, second])
+    assert sorted(frame.loc[frame["arm"] == "bo", "cycles"]) == [5, 300]
+    assert list(frame.loc[frame["arm"] == "plan", "cycles"]) == [5]

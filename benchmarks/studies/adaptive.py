@@ -19,12 +19,13 @@ recorded cycles (warm-up included), five ways of spending robot time:
 
 Every arm's best gait is scored the same way, on the simulator with the gait followed
 exactly (`suds_exp.gait.truth`): the gait-goal curve is that forward displacement per
-cycle against cycles recorded, as a share of --ceiling (mm per cycle, from
-`benchmarks/gait_ceiling.py`). The best gait of a learning arm is the recorded gait its
-map predicts best; of BO, the best evaluation. The map-goal curve (--map-budget > 0) is
-GMR's error on the fixed unseen gaits of `suds_exp.plan.unseen_gaits` (RMS distance of
-predicted from simulated net displacement per cycle, mm) for grid, random and the
-plan loop with --goal map.
+cycle against cycles recorded, as a share of --ceiling (mm per cycle, the global search of
+`benchmarks/studies/gait_ceiling.py`: 146.3, the best of its seeds 0 and 1, a gait that
+runs its loop twice a cycle; see docs/results/adaptive.md). The best gait of a learning
+arm is the recorded gait its map predicts best; of BO, the best evaluation. The map-goal
+curve (--map-budget > 0) is GMR's error on the fixed unseen gaits of
+`suds_exp.plan.unseen_gaits` (RMS distance of predicted from simulated net displacement
+per cycle, mm) for grid, random and the plan loop with --goal map.
 
 Each dataset seed's gait-goal arms are run several times (--repeats for plan and random,
 --peer-repeats for bo and tpe; grid and designer have no randomness of their own): run r's
@@ -35,6 +36,8 @@ peer's (`ratios`; the bar is <= 1/3).
 
 Run: .venv/bin/python -m benchmarks.studies.adaptive --seeds 0,1,2 --budget 50 --bo-budget 150
          [--map-budget 390 --map-arms plan,fullgrid] [--designer] [--out reports/adaptive]
+     (--from-curves reports/adaptive/curves.csv [--ceiling MM]: the gait summary of stored
+     runs recomputed against another ceiling, nothing run)
 
 For the map goal's plan loop the benchmark also measures where the map-error curve
 flattens (the next doubling of cycles lowers the error by less than its bootstrap
@@ -417,13 +420,69 @@ def run_stats(values: list[int | None]) -> dict:
 
 def over_runs(runs: list[dict]) -> dict:
     """A dataset seed's entry for one arm: the runs and their cycles to 80 % and 90 %."""
-    return {
+    out = {
         "repeats": len(runs),
         "cycles_to_80": run_stats([r["cycles_to_80"] for r in runs]),
         "cycles_to_90": run_stats([r["cycles_to_90"] for r in runs]),
         "median_share_of_ceiling": float(np.median([r["share_of_ceiling"] for r in runs])),
         "runs": runs,
     }
+    if all("share_at_budget" in r for r in runs):
+        out["median_share_at_budget"] = float(np.median([r["share_at_budget"] for r in runs]))
+    return out
+
+
+def run_entry(rows: list[dict], ceiling: float, budget: int) -> dict:
+    """One run's figures from its curve rows (in order of cycles): its last count and best
+    gait (mm per cycle), that as a share of ``ceiling``, the share of the best gait it had
+    within ``budget`` cycles (the learning arms' budget, so peers are read at it too) and
+    the cycles at which it first reached 80 % and 90 % of ``ceiling`` (None: never)."""
+    last = rows[-1]
+    within = [r["best_forward_mm"] for r in rows if r["cycles"] <= budget]
+    return {
+        "cycles": int(last["cycles"]),
+        "best_forward_mm": round(float(last["best_forward_mm"]), 2),
+        "share_of_ceiling": round(float(last["best_forward_mm"]) / ceiling, 3),
+        "share_at_budget": round(max(within) / ceiling, 3) if within else None,
+        "cycles_to_80": first_reaching(rows, 0.8 * ceiling),
+        "cycles_to_90": first_reaching(rows, 0.9 * ceiling),
+    }
+
+
+def summary_from_curves(
+    frame: pd.DataFrame, ceiling: float, budget: int, peer_budget: int
+) -> dict:  # fmt: skip
+    """The gait goal's summary (as a run writes it, without timings and job seeds)
+    recomputed from stored curves (curves.csv rows: goal, arm, seed, repeat, cycles,
+    best_forward_mm) against ``ceiling`` mm per cycle: no arm is run again."""
+    gait = frame[frame["goal"] == "gait"]
+    if "repeat" not in gait:
+        gait = gait.assign(repeat=0)
+    arms: dict = {}
+    for (arm, seed), part in gait.groupby(["arm", "seed"], sort=False):
+        runs = [
+            {"repeat": int(repeat)}
+            | run_entry(rows.sort_values("cycles").to_dict("records"), ceiling, budget)
+            for repeat, rows in part.groupby("repeat")
+        ]
+        arms.setdefault(arm, {})[str(seed)] = over_runs(runs)
+    summary = {"ceiling_mm": ceiling, "budget": budget, "peer_budget": peer_budget}
+    return summary | {"arms": arms, "ratios": ratios(arms, budget, peer_budget)}
+
+
+def read_curves(paths: list[Path]) -> pd.DataFrame:
+    """Stored curves.csv files as one frame; where two files hold the same arm on the same
+    dataset seed the later file's runs are taken (a longer rerun of a peer, say)."""
+    frames: list[pd.DataFrame] = []
+    for path in paths:
+        frame = pd.read_csv(path)
+        keys = set(zip(frame["goal"], frame["arm"], frame["seed"], strict=True))
+        frames = [
+            f[[k not in keys for k in zip(f["goal"], f["arm"], f["seed"], strict=True)]]
+            for f in frames
+        ]
+        frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
 
 
 def ratios(arms: dict, budget: int, peer_budget: int) -> dict:
@@ -461,9 +520,12 @@ def print_gait_table(summary: dict) -> None:
 
     for arm, per_seed in summary["arms"].items():
         for seed, e in per_seed.items():
+            at = e.get("median_share_at_budget")
             print(
                 f"{arm:>8} seed {seed} ({e['repeats']} runs): to 80 % {cell(e['cycles_to_80'])}; "
                 f"to 90 % {cell(e['cycles_to_90'])}"
+                + ("" if at is None else f"; median share at {summary['budget']} cycles {at:.3f}")
+                + f", at the end {e['median_share_of_ceiling']:.3f}"
             )
     for peer, per_seed in summary.get("ratios", {}).items():
         for seed, r in per_seed.items():
@@ -495,7 +557,10 @@ def main(argv=None) -> None:
     ap.add_argument("--map-budget", type=int, default=0, help="cycles of the map-goal arms")
     ap.add_argument("--cycles", type=int, default=5, help="cycles per planned/random/BO trial")
     ap.add_argument("--bound", type=float, default=1.3, help="joint bound, rad")
-    ap.add_argument("--ceiling", type=float, default=64.3, help="mm per cycle")
+    ap.add_argument(
+        "--ceiling", type=float, default=146.3,
+        help="mm per cycle: the best gait within the bound (benchmarks.studies.gait_ceiling)",
+    )  # fmt: skip
     ap.add_argument("--arms", default="grid,random,plan,bo,tpe", help="gait-goal arms ('' none)")
     ap.add_argument("--designer", action="store_true", help="also the designer on the grid")
     ap.add_argument(
@@ -518,6 +583,11 @@ def main(argv=None) -> None:
         help="map-goal arms (grid, random, plan, fullgrid: the full grid's error alone)",
     )  # fmt: skip
     ap.add_argument("--out", type=Path, default=Path("reports/adaptive"))
+    ap.add_argument(
+        "--from-curves", default="",
+        help="comma-separated curves.csv of earlier runs: recompute their gait summary "
+        "against --ceiling (seeds --seeds, budgets --budget and --bo-budget), run nothing",
+    )  # fmt: skip
     ap.add_argument("--quick", action="store_true", help="a smoke run at tiny budgets")
     args = ap.parse_args(argv)
     if args.quick:
@@ -528,6 +598,15 @@ def main(argv=None) -> None:
         atexit.register(shutil.rmtree, args.out, True)
     args.out.mkdir(parents=True, exist_ok=True)
     seeds = [int(s) for s in args.seeds.split(",")]
+    if args.from_curves:
+        frame = read_curves([Path(p) for p in args.from_curves.split(",")])
+        frame = frame[frame["seed"].isin(seeds) & (frame["goal"] == "gait")]
+        summary = summary_from_curves(frame, args.ceiling, args.budget, args.bo_budget)
+        print_gait_table(summary)
+        (args.out / "summary-from-curves.json").write_text(json.dumps(summary, indent=2))
+        draw(frame, args.ceiling, args.out)
+        print(f"wrote {args.out}/summary-from-curves.json and gait.png")
+        return
     arms = [a for a in args.arms.split(",") if a]
     truth = TargetTruth(Target.of(bound=args.bound))
     curves, summary = [], {"ceiling_mm": args.ceiling, "seeds": seeds, "arms": {}}
@@ -541,16 +620,9 @@ def main(argv=None) -> None:
                     {"goal": "gait", "arm": arm, "seed": seed, "repeat": repeat} | r for r in rows
                 ]
                 last = rows[-1]
-                entry = {
-                    "repeat": repeat,
-                    "job_seed": job_seed(arm, seed, repeat),
-                    "cycles": last["cycles"],
-                    "best_forward_mm": round(last["best_forward_mm"], 2),
-                    "share_of_ceiling": round(last["best_forward_mm"] / args.ceiling, 3),
-                    "cycles_to_80": first_reaching(rows, 0.8 * args.ceiling),
-                    "cycles_to_90": first_reaching(rows, 0.9 * args.ceiling),
-                    "seconds": round(seconds, 1),
-                }
+                entry = {"repeat": repeat, "job_seed": job_seed(arm, seed, repeat)}
+                entry |= run_entry(rows, args.ceiling, args.budget)
+                entry["seconds"] = round(seconds, 1)
                 if arm == "designer":
                     entry["grid_cycles"] = last["grid_cycles"]
                     entry["grid_map_error_mm"] = round(last["grid_map_error_mm"], 3)
