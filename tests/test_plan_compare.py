@@ -1,10 +1,10 @@
-"""The adaptive benchmark's comparison of the gait goal with its black-box peers: several
-runs a dataset seed, summarised by medians that count a run that never reached a level as
+"""Comparing gait-finding runs by the cycles they need (`suds_exp.plan.compare`, used by
+the adaptive benchmark): medians over runs that count a run that never reached a level as
 beyond any budget, and the plan loop's ratio of medians to each peer's."""
 
 import pandas as pd
 
-from benchmarks.studies.adaptive import (
+from suds_exp.plan.compare import (
     job_seed,
     over_runs,
     ratios,
