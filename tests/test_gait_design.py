@@ -200,6 +200,35 @@ def test_the_designer_s_tilted_start_is_the_phase_shifted_ellipse():
         )
 
 
+def test_a_loop_traced_twice_a_cycle_is_the_loop_at_twice_the_phase():
+    from suds_exp.errors import ConfigError
+    from suds_exp.gait.design import circle
+    from suds_exp.gait.shape import FourierGait
+
+    theta = np.linspace(0.0, 2 * np.pi, 50)
+    loop = ellipse(1.1, 0.9, 0.4, c1=0.1)
+    twice = loop.traced(2, order=2)
+    assert twice.order == 2
+    np.testing.assert_allclose(twice.shape(theta), loop.shape(2 * theta), atol=1e-12)
+    np.testing.assert_allclose(twice.rate(theta), 2 * loop.rate(2 * theta), atol=1e-12)
+    np.testing.assert_allclose(
+        circle(1.0, 2, lag=0.3, traces=2).shape(theta),
+        circle(1.0, 1, lag=0.3).shape(2 * theta),
+        atol=1e-12,
+    )
+    # an order-2 gait keeps only what fits: its first harmonic, traced twice
+    mixed = FourierGait([0.0, 0.0], [[1.0, 0.0], [0.2, 0.1]], [[0.0, 1.0], [0.0, 0.3]])
+    np.testing.assert_allclose(
+        mixed.traced(2, order=2).shape(theta),
+        FourierGait([0.0, 0.0], [[1.0, 0.0]], [[0.0, 1.0]]).shape(2 * theta),
+        atol=1e-12,
+    )
+    with pytest.raises(ConfigError, match="traces"):
+        circle(1.0, 2, traces=3)
+    with pytest.raises(ConfigError, match="times"):
+        loop.traced(0, order=2)
+
+
 def test_an_unknown_trust_radius_rule_is_refused():
     from suds_exp.errors import ConfigError
     from suds_exp.gait.design import DesignOptions

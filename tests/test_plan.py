@@ -412,9 +412,11 @@ def test_the_gait_goal_looks_beyond_a_trust_region_that_leaves_no_resolvable_ste
     support = Support.of(samples)
     target = Target.of(bound=1.2)
     trust = 0.001
+    # order 1: O traced twice a cycle would be a resolvable step on O's own path
     rec, best, best_value = recommend_gait(
-        ensemble, support, [NamedGait("O")], target, trust, 5, "next.toml", max_evals=30
-    )
+        ensemble, support, [NamedGait("O")], target, trust, 5, "next.toml", order=1,
+        max_evals=30,
+    )  # fmt: skip
     assert best.name == "O"
     gait = rec.trial.gait
     assert support.gait_distance(gait) > 10 * trust, rec.reason
@@ -424,3 +426,28 @@ def test_the_gait_goal_looks_beyond_a_trust_region_that_leaves_no_resolvable_ste
     mean, sd = ensemble.forward(gait, 0.5)
     assert rec.score == pytest.approx(expected_improvement(mean, sd, best_value))
     assert rec.score > expected_improvement(best_value, 0.0, best_value)
+
+
+def test_the_gait_goal_considers_a_loop_traced_twice_a_cycle(small):
+    # A principally kinematic body moves as far per loop however fast it traces it, so
+    # within an order-2 Fourier family the loop traced twice a cycle moves about twice
+    # as far per cycle. The learned map knows (GMR's map is homogeneous in the shape
+    # velocity); the search has to look there too, or its best gait is a local optimum.
+    from suds_exp.gait.shape import NamedGait
+    from suds_exp.gait.support import Support
+    from suds_exp.plan import MapEnsemble
+    from suds_exp.plan.recommend import recommend_gait
+    from suds_exp.preprocess import get_version
+
+    samples = get_version(Store(small), "v1").samples()
+    ensemble = MapEnsemble.fit(samples, n_boot=3, seed=0)
+    support = Support.of(samples)
+    rec, _, best_value = recommend_gait(
+        ensemble, support, [NamedGait("O")], Target.of(bound=1.2), 1.0, 5, "next.toml",
+        max_evals=40,
+    )  # fmt: skip
+    gait = rec.trial.gait
+    energy = (gait.a**2 + gait.b**2).sum(axis=1)
+    assert energy[1] > energy[0], (gait.a, gait.b)
+    assert rec.predicted_forward_mm > 1.5 * best_value, rec.reason
+    assert gait.max_abs() <= 1.2 + 1e-9

@@ -181,18 +181,33 @@ def circle(
     name: str = "circle",
     lag: float = 0.0,
     joints: tuple[str, ...] = SWIMMER_JOINTS,
+    traces: int = 1,
 ) -> FourierGait:
     """Joint j at r cos(t - j (pi/2 - lag)) rad, with ``order`` harmonics: for the
     swimmer phi1 = r cos t, phi2 = r sin(t + lag) (the paper's O at r = 1, lag = 0; a lag
     tilts the circle into an ellipse); on m joints the travelling wave it generalises
-    (one joint: r cos t)."""
+    (one joint: r cos t). ``traces``: times the loop is traced a cycle (t -> traces t;
+    at most ``order``)."""
+    if not 1 <= traces <= order:
+        raise ConfigError(f"circle: traces {traces}: expected 1 .. order ({order})")
     m = len(joints)
-    a = np.zeros((order, m))
-    b = np.zeros((order, m))
+    a = np.zeros((1, m))
+    b = np.zeros((1, m))
     behind = np.arange(m) * (np.pi / 2 - lag)
     a[0] = radius * np.cos(behind)
     b[0] = radius * np.sin(behind)
-    return FourierGait(np.zeros(m), a, b, name, joints)
+    return FourierGait(np.zeros(m), a, b, name, joints).traced(traces, order)
+
+
+def traced_starts(gaits, order: int) -> list[FourierGait]:
+    """Each Fourier gait of ``gaits`` traced 2 .. ``order`` times a cycle
+    (`FourierGait.traced`): starts a local search would not reach from loops traced
+    once. A rate-independent body goes about k times as far per cycle on a loop traced k
+    times, so the best gait of an order-2 family is often a loop traced twice; the map
+    judges each start, nothing here assumes it."""
+    return [
+        g.traced(k, order) for g in gaits if isinstance(g, FourierGait) for k in range(2, order + 1)
+    ]
 
 
 def optimise_gait(
@@ -317,7 +332,7 @@ def design_gait(
         name = f"design-{design_id}-it{it}.toml"
         starts = [
             _fit_inside(g, support, opts.bound, trust)
-            for g in (best, *_circle_starts(opts, joints))
+            for g in (best, *traced_starts([best], opts.order), *_circle_starts(opts, joints))
         ]
         if all(support.gait_distance(g) > trust for g in starts):
             # no circle fits the trust region (on a body of many joints whose data are not

@@ -144,6 +144,22 @@ class FourierGait(Gait):
         a, b = x[m : m + m * n].reshape(n, m), x[m + m * n :].reshape(n, m)
         return cls(x[:m], a, b, name, tuple(joints))
 
+    def traced(self, times: int, order: int) -> FourierGait:
+        """The loop of the gait's first ``order // times`` harmonics traced ``times`` times
+        a cycle, as a gait of ``order`` harmonics: r(theta) -> r(times theta), so harmonic n
+        becomes harmonic n x times and the rates scale by ``times``. A body whose motion
+        depends on the shape path alone (rate-independent, principally kinematic) moves
+        g^times per cycle where the loop moves g. Harmonics above ``order // times`` do
+        not fit and are left out (a start for a search, not a copy)."""
+        if times < 1 or order < times:
+            raise ConfigError(f"traced: times {times}, order {order}: expected 1 <= times <= order")
+        m = len(self.a0)
+        a, b = np.zeros((order, m)), np.zeros((order, m))
+        keep = min(self.order, order // times)
+        a[times - 1 : keep * times : times] = self.a[:keep]
+        b[times - 1 : keep * times : times] = self.b[:keep]
+        return FourierGait(self.a0, a, b, self.name, self.joints)
+
     def to_toml(self) -> str:
         """The TOML text `read_gait_file` reads back."""
         lines = [f'name = "{self.name}"']

@@ -54,7 +54,7 @@ import numpy as np
 import pandas as pd
 from scipy.spatial import cKDTree
 
-from suds_exp.gait.design import circle, optimise_gait
+from suds_exp.gait.design import circle, optimise_gait, traced_starts
 from suds_exp.gait.predict import fit_map
 from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, paper_gaits, within_bound
 from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns, direction_features
@@ -365,9 +365,13 @@ def recommend_gait(
         mean, sd = ensemble.forward(g, freq)
         return mean + KAPPA * sd
 
-    starts = [circle(1.0, order, lag=lag) for lag in START_LAGS_RAD]
+    starts = [
+        circle(1.0, order, lag=lag, traces=k)
+        for k in range(1, order + 1)
+        for lag in START_LAGS_RAD
+    ]
     if isinstance(best_gait, FourierGait) and best_gait.order == order:
-        starts.insert(0, best_gait)
+        starts[:0] = [best_gait, *traced_starts([best_gait], order)]
     starts = [_inside(g, support, target.bound, trust) for g in starts]
     gait, _ = optimise_gait(ucb, support, target.bound, trust, starts, max_evals, name)
     mean, sd = ensemble.forward(gait, freq)
@@ -409,11 +413,13 @@ def _look_beyond(
     ``order``; others are left out) are scored, and the search starts from the
     `GLOBAL_STARTS` best."""
     grid = [
-        within_bound(circle(f * bound, order, lag=lag), bound)
+        within_bound(circle(f * bound, order, lag=lag, traces=k), bound)
+        for k in range(1, order + 1)
         for f in GLOBAL_RADII_OF_BOUND
         for lag in GLOBAL_LAGS_RAD
     ]
-    grid += [g for g in seeds if isinstance(g, FourierGait) and g.order == order]
+    seeds = [g for g in seeds if isinstance(g, FourierGait) and g.order == order]
+    grid += seeds + traced_starts(seeds, order)
     scores = [objective(g) for g in grid]
     starts = [grid[i] for i in np.argsort(scores)[::-1][:GLOBAL_STARTS]]
     gait, _ = optimise_gait(objective, support, bound, np.inf, starts, max_evals, name)
