@@ -366,9 +366,7 @@ def recommend_gait(
         return mean + KAPPA * sd
 
     starts = [
-        circle(1.0, order, lag=lag, traces=k)
-        for k in range(1, order + 1)
-        for lag in START_LAGS_RAD
+        circle(1.0, order, lag=lag, traces=k) for k in range(1, order + 1) for lag in START_LAGS_RAD
     ]
     if isinstance(best_gait, FourierGait) and best_gait.order == order:
         starts[:0] = [best_gait, *traced_starts([best_gait], order)]
