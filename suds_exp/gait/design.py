@@ -28,8 +28,10 @@ Every iteration is stored in ``gait_design_iterations`` (migration 017).
 
 The optimiser is Nelder-Mead with penalties (a fitted map is cheap, a few ms a gait, but
 not smooth enough for gradients), started from the best gait so far and from the paper's
-circle O, plain and tilted either way (`LAGS_RAD`); on a body of m joints the circle is
-the travelling wave it generalises (`circle`). When none of these fits the trust region,
+circle O, plain and tilted either way (`LAGS_RAD`), and from the best gait traced 2 ..
+``order`` times a cycle (`traced_starts`: from a loop traced once, the search keeps the
+zero harmonics near zero); on a body of m joints the circle is the travelling wave it
+generalises (`circle`). When none of these fits the trust region,
 the search also starts from the data's mean path (`data_gait`).
 
 ``verify`` runs the swimmer simulator, so only a swimmer's version can be verified; any

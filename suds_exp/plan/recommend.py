@@ -42,7 +42,10 @@ Two goals:
   the data, so the upper bound rewards exploring where the map has not been told), and
   the gait with the larger expected improvement of the two is recommended. A look beyond
   is an extrapolation by design; the best gait reported is always a recorded one, so no
-  unrecorded prediction reaches the answer.
+  unrecorded prediction reaches the answer. Both searches also start from loops traced
+  2 .. ``order`` times a cycle (`suds_exp.gait.design.traced_starts`): a local search
+  from a loop traced once keeps its zero harmonics near zero, and on a rate-independent
+  body a loop traced k times a cycle moves about k times as far per cycle.
 """
 
 from __future__ import annotations
