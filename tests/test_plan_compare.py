@@ -3,12 +3,14 @@ the adaptive benchmark): medians over runs that count a run that never reached a
 beyond any budget, and the plan loop's ratio of medians to each peer's."""
 
 import pandas as pd
+import pytest
 
 from suds_exp.plan.compare import (
     job_seed,
     over_runs,
     ratios,
     read_curves,
+    run_entry,
     run_stats,
     summary_from_curves,
 )
@@ -94,3 +96,12 @@ def test_a_later_curves_file_replaces_an_earlier_ones_runs_of_the_same_arm_and_s
     frame = read_curves([first, second])
     assert sorted(frame.loc[frame["arm"] == "bo", "cycles"]) == [5, 300]
     assert list(frame.loc[frame["arm"] == "plan", "cycles"]) == [5]
+
+
+def test_a_run_with_no_count_within_the_budget_has_no_share_there():
+    # the designer's one run starts beyond the learning arms' budget (the full grid)
+    runs = [run_entry([{"cycles": 1222, "best_forward_mm": 76.2}], ceiling=146.3, budget=50)]
+    assert runs[0]["share_at_budget"] is None
+    out = over_runs(runs)
+    assert "median_share_at_budget" not in out
+    assert out["median_share_of_ceiling"] == pytest.approx(0.521)

@@ -55,7 +55,8 @@ def over_runs(runs: list[dict]) -> dict:
         "median_share_of_ceiling": float(np.median([r["share_of_ceiling"] for r in runs])),
         "runs": runs,
     }
-    if all("share_at_budget" in r for r in runs):
+    # a run with no count within the budget (the designer: the full grid first) has none
+    if all(r.get("share_at_budget") is not None for r in runs):
         out["median_share_at_budget"] = float(np.median([r["share_at_budget"] for r in runs]))
     return out
 
