@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from suds_exp.gait.design import circle
-from suds_exp.gait.motion import cycle_motion, integrate_twists
+from suds_exp.gait.motion import cycle_motion, integrate_twists, recorded_cycles, se2_exp
 from suds_exp.gait.predict import (
     MEASURED,
     N_CYCLES,
@@ -90,3 +90,15 @@ def test_a_shared_table_is_read_only(train):
         first["t"][0] = 1.0
     second = table.columns(circle(0.5, 1))
     assert first["t"] is second["t"] and first["ra_1"] is not second["ra_1"]
+
+
+def test_a_recording_is_cut_into_whole_periods_from_its_first_sample():
+    # a constant twist moves the body by exp(xi T) each period; a recording of 4.3
+    # periods has 4 whole ones
+    dt, period = 0.01, 2.0
+    xi = np.array([12.0, -3.0, 0.4])
+    twists = np.tile(xi, (int(round(4.3 * period / dt)) + 1, 1))
+    cycles = recorded_cycles(twists, dt, period)
+    assert cycles.shape == (4, 3)
+    np.testing.assert_allclose(cycles, np.tile(se2_exp(xi[None], period), (4, 1)), atol=1e-9)
+    assert recorded_cycles(twists[:150], dt, period).shape == (0, 3)

@@ -221,6 +221,36 @@ def test_the_gait_goal_records_designed_gaits_within_the_bound(gait_loop):
     assert gaits == ["O", planned.trial["gait"]]
 
 
+def test_the_gait_goal_s_best_gait_is_the_one_that_went_furthest_in_its_trials(gait_loop):
+    from suds_exp.plan.loop import measured_forward
+    from suds_exp.preprocess import get_version
+
+    db, loop = gait_loop
+    measured = measured_forward(get_version(Store(db)).samples(), 0.5)
+    assert set(measured) == {"O", loop.iterations[1].trial["gait"]}
+    furthest = max(measured, key=measured.get)
+    assert loop.iterations[-1].best_gait.name == furthest, measured
+    # O's forward motion per cycle as recorded (the simulator's 24.3 mm, less the
+    # actuator's lag)
+    assert 15.0 < measured["O"] < 30.0
+
+
+def test_the_best_gait_follows_the_recording_not_the_map(tmp_path, monkeypatch):
+    # a tiny loop's map ranks the warm-up's O above its one designed gait; a recording
+    # in which the designed gait went furthest makes it the best gait all the same
+    import suds_exp.plan.loop as loop_module
+
+    def designed_furthest(samples, frequency_hz):
+        return {g: 1e3 for g in set(samples["gait"]) if g != "O"}
+
+    monkeypatch.setattr(loop_module, "measured_forward", designed_furthest)
+    loop = run_loop(
+        Store(tmp_path / "g.duckdb"), tiny(goal="gait", budget_cycles=9, bound=1.2),
+        out=tmp_path / "o",
+    )  # fmt: skip
+    assert loop.iterations[1].best_gait.name == loop.iterations[1].trial["gait"]
+
+
 def test_an_interrupted_loop_keeps_what_was_stored_and_continues(tmp_path, monkeypatch):
     import suds_exp.plan.loop as loop_module
 

@@ -63,6 +63,21 @@ def integrate_twists(xi: np.ndarray, dt: float, pose0=(0.0, 0.0, 0.0)) -> np.nda
     return np.column_stack([x0 + _from_zero(np.cumsum(dx)), y0 + _from_zero(np.cumsum(dy)), theta])
 
 
+def recorded_cycles(twists: np.ndarray, dt: float, period_s: float) -> np.ndarray:
+    """Net motion of each whole period of a recording: body twists (n, 3) (vx, vy mm/s, wz
+    rad/s) sampled every dt s, integrated (path-ordered) and cut every ``period_s`` s from
+    the first sample. Returns (cycles, 3): forward, lateral (mm, body frame at each
+    period's start) and turn (rad); no row when the recording is shorter than a period.
+    A period that starts elsewhere than the gait's phase 0 turns the first two by the
+    body's heading there, not the distance."""
+    per = int(round(period_s / dt))
+    n = (len(twists) - 1) // per if per > 0 else 0
+    if n < 1:
+        return np.zeros((0, 3))
+    poses = integrate_twists(twists[: n * per + 1], dt)
+    return relative(poses[: n * per : per], poses[per : n * per + 1 : per])
+
+
 def _from_zero(cumulative: np.ndarray) -> np.ndarray:
     """0 then ``cumulative`` (n,): shape (n + 1,) (np.r_[0.0, x] at a tenth of its cost;
     the designer integrates thousands of rollouts)."""

@@ -97,7 +97,7 @@ def plan_next(
         rec, _, _ = recommend_gait(
             ensemble,
             Support.of(samples),
-            _recorded_gaits(samples, out),
+            _recorded_gaits(samples, out)[1],
             target,
             trust,
             cycles,

@@ -4,7 +4,8 @@ Each iteration records what `suds_exp.plan.recommend` asked for (`add_trial_to_v
 simulate with the trial's seed, ingest, preprocess into the version), refits the learner
 with its bootstrap refits, and stores one row of ``plan_iterations`` (migration 022):
 the trial and its reason, the cycles recorded so far, the map's error on the target set,
-the best recorded gait and its predicted and simulator-achieved forward displacement per
+the best recorded gait (the one that went furthest per cycle in its own trials, as
+recorded: `measured_forward`) and its predicted and simulator-achieved forward displacement per
 cycle, the stopping signal (the map goal's forecast for the next doubling and latched,
 the gait goal's the learning curve's: `suds_exp.plan.curve`) and the gait goal's trust radius.
 
@@ -36,6 +37,7 @@ import sqlalchemy as sa
 from filelock import FileLock, Timeout
 
 from suds_exp.errors import ConfigError, PreprocessError, StoreError
+from suds_exp.gait.motion import recorded_cycles
 from suds_exp.gait.predict import derive_seed
 from suds_exp.gait.shape import FourierGait, Gait, NamedGait, read_gait_file
 from suds_exp.gait.support import Support
@@ -212,10 +214,16 @@ class _State:
         seed = derive_seed("plan-fit", name, it)
         self.ensemble = MapEnsemble.fit(self.samples, opts.learner, opts.n_boot, seed)
         self.support = Support.of(self.samples)
-        self.gaits = _recorded_gaits(self.samples, folder)
+        labels, self.gaits = _recorded_gaits(self.samples, folder)
         freq = target.frequencies_hz[0]
         preds = [self.ensemble.point.forward(g, freq) for g in self.gaits]
-        i = int(np.argmax(preds))
+        # the trust rule's baseline: the map's own best, so its gains are the map's
+        self.top_predicted = float(max(preds))
+        # the best gait is the one that went furthest in its own trials: the map smooths
+        # a peak away, and re-ranks recorded gaits as it learns elsewhere
+        measured = measured_forward(self.samples, freq)
+        score = [measured.get(label, -np.inf) for label in labels]
+        i = int(np.argmax(score)) if np.isfinite(max(score)) else int(np.argmax(preds))
         self.best, self.best_predicted = self.gaits[i], float(preds[i])
         if self.best.name not in achieved:
             achieved[self.best.name] = simulate_gaits([self.best], freq)[0].forward_mm
@@ -256,19 +264,41 @@ def version_cycles(samples: pd.DataFrame) -> int:
     return int(round(total))
 
 
-def _recorded_gaits(samples: pd.DataFrame, folder: Path) -> list[Gait]:
-    """The gaits the version's trials ran that the planner knows: the paper's gaits and
-    the gait files under ``folder`` (a loop's, or those `plan next` wrote there and the
-    user recorded), matched by name; at least the paper's O."""
-    labels = sorted(set(samples["gait"].dropna().astype(str)))
+def _recorded_gaits(samples: pd.DataFrame, folder: Path) -> tuple[list[str], list[Gait]]:
+    """The gaits the version's trials ran that the planner knows, with their trials' gait
+    labels: the paper's gaits and the gait files under ``folder`` (a loop's, or those
+    `plan next` wrote there and the user recorded), matched by name; at least the
+    paper's O."""
     files = {p.name: p for p in folder.glob("**/*.toml")}
-    gaits: list[Gait] = []
-    for label in labels:
+    labels, gaits = [], []
+    for label in sorted(set(samples["gait"].dropna().astype(str))):
         if label in GAITS:
             gaits.append(NamedGait(label))
         elif label in files:
             gaits.append(read_gait_file(files[label]))
-    return gaits or [NamedGait("O")]
+        else:
+            continue
+        labels.append(label)
+    return (labels, gaits) if gaits else (["O"], [NamedGait("O")])
+
+
+def measured_forward(samples: pd.DataFrame, frequency_hz: float) -> dict[str, float]:
+    """Forward displacement per cycle (mm) each gait label's trials at ``frequency_hz``
+    (Hz) recorded: the body twists of each trial integrated over its whole periods from
+    its first sample (`suds_exp.gait.motion.recorded_cycles`), averaged over the periods
+    of all its trials. Labels with no whole period at that frequency are left out."""
+    out: dict[str, list[np.ndarray]] = {}
+    for _, trial in samples.groupby("trial_id", sort=True):
+        if abs(float(trial["frequency_hz"].iloc[0]) - frequency_hz) > 1e-9:
+            continue
+        t = trial["t"].to_numpy(float)
+        if len(t) < 2:
+            continue
+        twists = trial[["vx", "vy", "wz"]].to_numpy(float)
+        cycles = recorded_cycles(twists, float(np.median(np.diff(t))), 1.0 / frequency_hz)
+        if len(cycles):
+            out.setdefault(str(trial["gait"].iloc[0]), []).append(cycles[:, 0])
+    return {label: float(np.concatenate(parts).mean()) for label, parts in out.items()}
 
 
 def check_body(version) -> None:
@@ -401,7 +431,7 @@ def _run(store, opts, target, version, name, folder, config, progress, on_iterat
                 config,
                 added_by=f"plan loop {name}",
             )
-            before, signal_before = state.best_predicted, state.raw_curve
+            before, signal_before = state.top_predicted, state.raw_curve
             state = _State(store, version, opts, target, truth, folder, name, it, achieved)
             if opts.goal == "map":
                 fired = any(i.stop for i in loop.iterations)
