@@ -151,6 +151,7 @@ ModelOption = Annotated[
 LearnerAlias = Annotated[str | None, old_name("--learner", "--model")]
 FreqOption = Annotated[str, option("Gait frequency, Hz (one value, e.g. 1/2).", metavar="HZ")]
 FreqAlias = Annotated[str | None, old_name("--freq", "--freqs")]
+BootAlias = Annotated[int | None, old_name("--boot", "--boots")]
 TargetFreqsOption = Annotated[
     str | None, option("Target frequencies, Hz (default 1/2).", "--freqs", metavar="HZ,...")
 ]
@@ -793,7 +794,7 @@ def report(
 def findings(
     name: CampaignArgument,
     boots: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
-    boot: Annotated[int | None, old_name("--boot", "--boots")] = None,
+    boot: BootAlias = None,
     seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -993,7 +994,7 @@ def gait_predict(
     boots: Annotated[
         int, typer.Option(help="Bootstrap refits for the 95 % intervals: 0 (none) or 40+.")
     ] = 40,
-    boot: Annotated[int | None, old_name("--boot", "--boots")] = None,
+    boot: BootAlias = None,
     bound: Annotated[float, typer.Option(help="Joint bound the gait must keep, rad.")] = 2.0,
     db: DbOption = None,
     json_: JsonOption = False,

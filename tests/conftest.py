@@ -252,12 +252,13 @@ def inertia_store():
     simulated into folder ``work`` with body inertia ``tau_s`` (s), an effect the nominal
     model lacks."""
     from suds_exp.sim.config import SimConfig
+    from suds_exp.sim.dataset import SimDesign
     from suds_exp.workflows.hidden_effects import simulate_measured
 
     def make(work: Path, tau_s: float, seed: int) -> Path:
         truth = SimConfig()
         truth.effects.body_inertia.tau_s = tau_s
-        simulate_measured(work, truth, seed=seed, **SMALL_SWEEP)
+        simulate_measured(work, truth, SimDesign(seed=seed, **SMALL_SWEEP))
         return work / "suds.duckdb"
 
     return make

@@ -126,12 +126,11 @@ def _synthetic(rng, signal: float):
 
 @pytest.mark.parametrize("signal", [0.0, 1.0])
 def test_discovery_recovers_a_term_and_discovers_nothing_in_noise(signal):
-    from suds_exp.discrepancy.discover import discover
+    from suds_exp.discrepancy.discover import Gap, discover
 
     X, feats, sim, meas, trial_id = _synthetic(np.random.default_rng(7), signal)
-    d = discover(
-        X, feats, sim, meas, np.ones(3), trial_id, range(6), ("vx", "vy", "wz"), 0.01, 0.05
-    )
+    gap = Gap(sim, meas, np.ones(3), trial_id, range(6))
+    d = discover(X, feats, gap, ("vx", "vy", "wz"), 0.01, 0.05)
     if signal == 0:
         assert not d.significant and d.terms == [] and d.physics == ""
         return
@@ -149,7 +148,7 @@ def test_a_large_lag_of_a_channel_is_one_lagged_copy_of_the_model():
     from types import SimpleNamespace
 
     from suds_exp.discrepancy import features
-    from suds_exp.discrepancy.discover import discover
+    from suds_exp.discrepancy.discover import Gap, discover
 
     rng = np.random.default_rng(11)
     n_win, n_s, dt = 16, 400, 0.01
@@ -171,11 +170,7 @@ def test_a_large_lag_of_a_channel_is_one_lagged_copy_of_the_model():
     d = discover(
         X,
         one,
-        sim,
-        meas,
-        np.ones(4),
-        trial_id,
-        range(8),
+        Gap(sim, meas, np.ones(4), trial_id, range(8)),
         ("vx", "vy", "wz", "rp_1"),
         0.01,
         0.05,
@@ -214,7 +209,7 @@ def test_physics_reads_the_body_and_the_passive_shape_apart():
 def test_constancy_flags_an_effect_whose_strength_grows_with_distance(drift):
     """The remainder after a named effect D: a constant mis-scale of D (plus noise) is
     absorbed by D itself; a strength growing with distance s is not, and is flagged."""
-    from suds_exp.discrepancy.discover import effect_constancy
+    from suds_exp.discrepancy.discover import Gap, effect_constancy
     from suds_exp.discrepancy.features import Feature
 
     rng = np.random.default_rng(3)
@@ -232,7 +227,8 @@ def test_constancy_flags_an_effect_whose_strength_grows_with_distance(drift):
     meas = sim + 0.2 * D + drift * (s[..., None] - 0.5) * D
     meas = meas + rng.normal(scale=0.3, size=sim.shape)
     trial_id = np.repeat(np.arange(12), 2)
-    c = effect_constancy(Xe, feats, sim, meas, np.ones(3), trial_id, range(6), 0.01, 0.05)
+    gap = Gap(sim, meas, np.ones(3), trial_id, range(6))
+    c = effect_constancy(Xe, feats, gap, 0.01, 0.05)
     assert c.significant == bool(drift), (c.p_value, c.improvement)
     if drift:
         assert c.varies_with == "distance" and c.improvement > 0.3

@@ -20,6 +20,7 @@ from suds_exp.commands.simulate import simulate_command
 from suds_exp.errors import ConfigError
 from suds_exp.preprocess import preprocess
 from suds_exp.preprocess.truth import truth_errors
+from suds_exp.sim.dataset import SimDesign
 from suds_exp.store import Store
 
 #: the simulated robot's distance between its motor axes (SimConfig.geometry), mm
@@ -28,7 +29,9 @@ MIDDLE_MM = 100.0
 
 def simulated(folder: Path, gaits) -> Store:
     store = Store(folder / "sim.duckdb")
-    simulate_command(folder / "data", store=store, gaits=gaits, repeats=1, cycles=(4, 4))
+    simulate_command(
+        folder / "data", store=store, design=SimDesign(gaits, repeats=1, cycles=(4, 4))
+    )
     return store
 
 
@@ -68,7 +71,9 @@ def test_gaits_that_pin_the_axes_down_give_no_warning(tmp_path):
 def test_the_command_prints_the_warning_and_takes_the_distance(one_loop, tmp_path):
     db = tmp_path / "copy.duckdb"
     store = Store(db)
-    simulate_command(tmp_path / "data", store=store, gaits=("O",), repeats=1, cycles=(4, 4))
+    simulate_command(
+        tmp_path / "data", store=store, design=SimDesign(("O",), repeats=1, cycles=(4, 4))
+    )
     runner = CliRunner()
     out = runner.invoke(app, ["preprocess", "--db", str(db)])
     assert out.exit_code == 0, out.output

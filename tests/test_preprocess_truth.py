@@ -15,12 +15,13 @@ import pytest
 from suds_exp.commands.simulate import simulate_command
 from suds_exp.preprocess import preprocess
 from suds_exp.preprocess.truth import truth_errors
+from suds_exp.sim.dataset import SimDesign
 from suds_exp.store import Store
 
 
 def simulated_store(folder: Path, **design) -> Store:
     store = Store(folder / "sim.duckdb")
-    simulate_command(folder / "data", store=store, **design)
+    simulate_command(folder / "data", store=store, design=SimDesign(**design))
     return store
 
 

@@ -117,3 +117,23 @@ def test_dropouts_are_written_as_zeros_and_read_as_missing(tmp_path):
     missing = np.isnan(capture.xyz).all(axis=2)
     assert 0 < missing.mean() < 0.2
     assert b"\t0.000\t0.000\t0.000" in ds.tsv_paths[0].read_bytes()
+
+
+def test_a_design_is_one_checked_value_that_simulates_as_its_keywords(tmp_path):
+    from suds_exp.errors import ConfigError
+    from suds_exp.sim import SimDesign
+    from suds_exp.workflows.simulate import simulate_and_ingest
+
+    design = SimDesign(["O", "D+"], [1], repeats=2, cycles=[3, 5], seed=7)
+    assert design == SimDesign(("O", "D+"), (1.0,), 2, (3, 5), 7)
+    assert design.frequencies_hz == (1.0,) and design.cycles == (3, 5)
+    run = simulate_and_ingest(None, tmp_path / "a", design=design)
+    again = simulate_dataset(tmp_path / "b", seed=7, **DESIGN)
+    assert [p.read_bytes() for p in run.dataset.tsv_paths] == [
+        p.read_bytes() for p in again.tsv_paths
+    ]
+    with pytest.raises(ConfigError, match=r"gaits \['O', 'X'\]: expected some of") as bad:
+        SimDesign(("O", "X"))
+    assert bad.value.param == "gaits"
+    with pytest.raises(ConfigError, match=r"cycles \(5, 3\): expected 1 <= MIN <= MAX"):
+        SimDesign(cycles=(5, 3))

@@ -40,9 +40,10 @@ from suds_exp.body import load_body, preprocess_body
 from suds_exp.commands.simulate import simulate_command
 from suds_exp.preprocess import preprocess
 from suds_exp.preprocess.truth import truth_errors
+from suds_exp.sim.dataset import SimDesign
 from suds_exp.store import Store
 
-#: ``--quick``'s design (keywords of `simulate_command`).
+#: ``--quick``'s design (keywords of `SimDesign`).
 QUICK_DESIGN = {"gaits": ("O", "D+"), "frequencies_hz": (0.5, 1.0), "repeats": 2, "cycles": (4, 4)}
 
 
@@ -65,7 +66,7 @@ def main(argv=None) -> None:
         if source is None:
             source = tmp / "source.duckdb"
             t0 = time.perf_counter()
-            simulate_command(tmp / "data", store=Store(source), seed=0, **design)
+            simulate_command(tmp / "data", store=Store(source), design=SimDesign(seed=0, **design))
             print(f"simulated and ingested in {time.perf_counter() - t0:.1f} s", file=sys.stderr)
         runs, result, copy = [], None, None
         for i in range(args.repeats):

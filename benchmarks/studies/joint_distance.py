@@ -22,6 +22,7 @@ from suds_exp.preprocess import preprocess
 from suds_exp.preprocess.truth import truth_errors
 from suds_exp.robot import GAITS
 from suds_exp.sim.config import SimConfig
+from suds_exp.sim.dataset import SimDesign
 from suds_exp.store import Store
 from suds_exp.workflows.simulate import simulate_and_ingest
 
@@ -38,7 +39,7 @@ DESIGNS: dict[str, dict] = {
 
 def row(folder: Path, name: str, design: dict, seed: int) -> str:
     store = Store(folder / "db.duckdb")
-    simulate_and_ingest(store, folder / "data", seed=seed, **design)
+    simulate_and_ingest(store, folder / "data", design=SimDesign(seed=seed, **design))
     fitted = preprocess(store, name="fitted", progress=False)
     truth = SimConfig().geometry.middle_length_mm
     known = preprocess(store, name="known", params={"joint_distance_mm": truth}, progress=False)

@@ -43,6 +43,7 @@ from benchmarks._harness import script_parser
 from suds_exp.commands.simulate import simulate_command
 from suds_exp.preprocess import Phaser, load_samples, preprocess
 from suds_exp.preprocess.truth import truth_path
+from suds_exp.sim.dataset import SimDesign
 from suds_exp.store import Store
 
 ORDER = 10
@@ -101,10 +102,8 @@ def gait_cases(seed: int, frequencies=(1 / 3, 0.5, 1.0)) -> dict[str, dict]:
     out = {}
     with tempfile.TemporaryDirectory(prefix="suds-phaser-bench-") as tmp:
         store = Store(Path(tmp) / "bench.duckdb")
-        simulate_command(
-            Path(tmp) / "data", gaits=["D+"], frequencies_hz=frequencies, repeats=6,
-            cycles=(12, 16), seed=seed, store=store,
-        )  # fmt: skip
+        design = SimDesign(("D+",), frequencies, repeats=6, cycles=(12, 16), seed=seed)
+        simulate_command(Path(tmp) / "data", store=store, design=design)
         preprocess(store, progress=False)
         samples = load_samples(store, 1)
         files = store.query_df("SELECT id, source_file FROM trials")

@@ -14,9 +14,10 @@ from suds_exp.errors import ConfigError
 from suds_exp.robot import FREQUENCIES_HZ, GAITS, parse_frequency
 from suds_exp.sim.config import SimConfig, load_config
 from suds_exp.sim.connection import local_connection, save_connection
+from suds_exp.sim.dataset import SimDesign, check_cycles
 from suds_exp.sim.effects import apply_effects, effect_library
 from suds_exp.sim.schedule import split_effects
-from suds_exp.workflows.simulate import check_cycles, simulate_and_ingest
+from suds_exp.workflows.simulate import simulate_and_ingest
 
 
 def parse_gaits(text: str | None) -> tuple[str, ...]:
@@ -86,14 +87,17 @@ def build_config(
     return apply_effects(cfg, effects, param)
 
 
-def simulate_command(out: Path, store=None, progress: bool = False, **design) -> dict:
-    """Simulate a design into `out` and (given a `Store`) ingest it; a JSON-ready summary.
-
-    ``design``: the keywords of `suds_exp.workflows.simulate.simulate_and_ingest`
-    (``config``, ``gaits``, ``frequencies_hz``, ``repeats``, ``cycles``, ``seed``,
-    ``changes``), which checks them; ``progress``: a bar over the trials.
-    """
-    run = simulate_and_ingest(store, out, progress=progress, **design)
+def simulate_command(
+    out: Path,
+    store=None,
+    progress: bool = False,
+    config: SimConfig | None = None,
+    design: SimDesign | None = None,
+) -> dict:
+    """Simulate ``design`` (a `SimDesign`; default: the paper's) on the robot of
+    ``config`` into `out` and (given a `Store`) ingest it; a JSON-ready summary.
+    ``progress``: a bar over the trials."""
+    run = simulate_and_ingest(store, out, config, design, progress=progress)
     ds = run.dataset
     summary = {
         "out": str(out),
@@ -201,18 +205,8 @@ def simulate_options(
         )
     gait_list, freq_list, cycle_range = parse_gaits(gaits), parse_freqs(freqs), parse_cycles(cycles)
     static, changes = split_effects(list(effects))
-    return simulate_command(
-        out,
-        store,
-        progress,
-        config=build_config(config_path, static),
-        gaits=gait_list,
-        frequencies_hz=freq_list,
-        repeats=repeats,
-        cycles=cycle_range,
-        seed=seed,
-        changes=changes,
-    )
+    design = SimDesign(gait_list, freq_list, repeats, cycle_range, seed, changes)
+    return simulate_command(out, store, progress, build_config(config_path, static), design)
 
 
 def _simulate_gait_file(

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from sklearn.linear_model import orthogonal_mp
@@ -240,14 +241,42 @@ def _boot_intervals(X, y, groups, support, settings: DiscoverySettings, rng):
     return np.quantile(reps, tail, axis=0), np.quantile(reps, 1 - tail, axis=0)
 
 
+@dataclass(frozen=True)
+class Gap:
+    """What a correction is fitted to and tested on: the current model's replay ``sim``
+    and the measurement ``meas``, arrays (n_windows, n_samples, n_channels); the
+    channels' loss ``scales`` (n_channels,); each window's ``trial_id`` (n_windows,); the
+    ids of the ``train_trials`` (every other window is held out)."""
+
+    sim: np.ndarray
+    meas: np.ndarray
+    scales: np.ndarray
+    trial_id: np.ndarray
+    train_trials: object
+
+    @cached_property
+    def is_train(self) -> np.ndarray:
+        """(n_windows,) bool: the window is of a training trial."""
+        return np.isin(self.trial_id, np.asarray(list(self.train_trials)))
+
+    def remainder(self) -> np.ndarray:
+        """(meas - sim) / scales, a row a sample: (n_windows * n_samples, n_channels)."""
+        return ((self.meas - self.sim) / self.scales).reshape(-1, self.sim.shape[-1])
+
+    def held_out(self, replays: np.ndarray, min_improvement: float):
+        """(trials, losses (2, n_trials), p) of two ``replays`` (2, n_held_out_windows,
+        n_samples, n_channels) of the held-out windows, before and after a correction:
+        p of the one-sided test that the second removes more than ``min_improvement``
+        of the first's loss (`held_out_p`)."""
+        test = ~self.is_train
+        trials, loss = trial_losses(replays, self.meas[test], self.scales, self.trial_id[test])
+        return trials, loss, held_out_p(loss[0], loss[1], min_improvement)
+
+
 def discover(
     X: np.ndarray,
     features: list[Feature],
-    sim: np.ndarray,
-    meas: np.ndarray,
-    scales: np.ndarray,
-    trial_id: np.ndarray,
-    train_trials,
+    gap: Gap,
     channels: tuple[str, ...],
     alpha: float,
     min_improvement: float,
@@ -262,12 +291,9 @@ def discover(
     ----------
     X : array (n_windows, n_samples, n_features)
         `feature_library` of the windows (shared by every channel).
-    sim, meas : arrays (n_windows, n_samples, n_channels)
-        The current model's replay and the measurement (channels as `replay`).
-    scales : array (n_channels,)
-        Loss scales of the channels (the workflow's).
-    trial_id : array (n_windows,)
-    train_trials : ids of the training trials; every other window is held out.
+    gap : Gap
+        The current model's replay and the measurement (channels as `replay`), the
+        workflow's loss scales and the training trials.
     channels : names of the channels.
     alpha, min_improvement : the held-out test's level and margin (as for candidates).
     Xc : array (n_windows, n_samples, n_channels, n_rest), optional
@@ -282,10 +308,10 @@ def discover(
     if Xc is None:
         Xc = np.zeros((n_win, n_s, len(channels), 0))
     n_g = Xc.shape[-1]
-    is_train = np.isin(trial_id, np.asarray(list(train_trials)))
-    groups_all = np.repeat(trial_id, n_s)
-    target = ((meas - sim) / scales).reshape(-1, len(channels))
-    row_train = np.repeat(is_train, n_s)
+    sim, scales = gap.sim, gap.scales
+    groups_all = np.repeat(gap.trial_id, n_s)
+    target = gap.remainder()
+    row_train = np.repeat(gap.is_train, n_s)
     coef = np.zeros((len(channels), n_f + n_g))
     terms = []
     chosen = {}
@@ -310,13 +336,11 @@ def discover(
             a, b = sorted((lo[j] * to_phys, hi[j] * to_phys))
             terms.append(Term(ch, all_feats[f], coef[c, f], (a, b), abs(xi[f])))
     out = Discovery(tuple(channels), all_feats, coef, n_f, terms, chosen)
-    test = ~is_train
+    test = ~gap.is_train
     corrected = sim[test] + np.nan_to_num(out.predict(X[test], Xc[test]))
-    trials, loss = trial_losses(
-        np.stack([sim[test], corrected]), meas[test], scales, trial_id[test]
-    )
+    trials, loss, p = gap.held_out(np.stack([sim[test], corrected]), min_improvement)
     out.test_trials, out.test_before, out.test_after = trials, loss[0], loss[1]
-    out.p_value = held_out_p(loss[0], loss[1], min_improvement) if terms else 1.0
+    out.p_value = p if terms else 1.0
     out.significant = out.p_value < alpha
     out.seconds = time.perf_counter() - started
     return out
@@ -347,11 +371,7 @@ class Constancy:
 def effect_constancy(
     Xe: np.ndarray,
     features: list[Feature],
-    sim: np.ndarray,
-    meas: np.ndarray,
-    scales: np.ndarray,
-    trial_id: np.ndarray,
-    train_trials,
+    gap: Gap,
     alpha: float,
     min_improvement: float,
     effect: str = "",
@@ -361,7 +381,7 @@ def effect_constancy(
     ``Xe`` (n_windows, n_samples, n_channels, n) is `features.effect_features` of the
     effect: its contribution D and D times distance, time, each segment sliding forward
     and each condition. On the training trials, per channel, the remainder ``meas - sim``
-    (``sim`` is the replay with the effect) is regressed by least squares once on D
+    of ``gap`` (its ``sim`` is the replay with the effect) is regressed by least squares once on D
     alone (a constant re-scaling of the effect: absorbs a slightly mis-fitted parameter)
     and once on all of them. On the held-out trials, the one-sided paired t-test that the
     varying fit removes more than ``min_improvement`` of the constant fit's loss, at
@@ -370,9 +390,9 @@ def effect_constancy(
     and is reported as a partial explanation, not as the cause.
     """
     n_win, n_s, n_ch, n_e = Xe.shape
-    is_train = np.isin(trial_id, np.asarray(list(train_trials)))
-    row_train = np.repeat(is_train, n_s)
-    target = ((meas - sim) / scales).reshape(-1, n_ch)
+    scales = gap.scales
+    row_train = np.repeat(gap.is_train, n_s)
+    target = gap.remainder()
     corr = np.zeros((2, n_win * n_s, n_ch))
     share = np.zeros(n_e)
     for c in range(n_ch):
@@ -388,9 +408,8 @@ def effect_constancy(
             if k == 1:
                 share[cols] += np.abs(b) * rms[cols]
     corr = corr.reshape(2, n_win, n_s, n_ch)
-    test = ~is_train
-    trials, loss = trial_losses(sim[None, test] + corr[:, test], meas[test], scales, trial_id[test])
-    p = held_out_p(loss[0], loss[1], min_improvement)
+    test = ~gap.is_train
+    _, loss, p = gap.held_out(gap.sim[None, test] + corr[:, test], min_improvement)
     varying = share[1:]
     fam = features[1 + int(np.argmax(varying))].family if varying.any() else ""
     return Constancy(effect, loss[0], loss[1], p, p < alpha, fam)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from suds_exp.discrepancy.discover import Discovery, discover, effect_constancy
+from suds_exp.discrepancy.discover import Discovery, Gap, discover, effect_constancy
 from suds_exp.discrepancy.features import channel_features, effect_features, feature_library
 from suds_exp.discrepancy.replay import WindowSet
 
@@ -54,18 +54,8 @@ def check_named(
     Xe, feats = effect_features(
         full, samples, sim_after, sim_after - sim_before, label, half_middle_mm
     )
-    step.constancy = effect_constancy(
-        Xe,
-        feats,
-        sim_after,
-        meas,
-        scales,
-        full.trial_id,
-        train_ids,
-        opts.alpha,
-        opts.fit.min_improvement,
-        label,
-    )
+    gap = Gap(sim_after, meas, scales, full.trial_id, train_ids)
+    step.constancy = effect_constancy(Xe, feats, gap, opts.alpha, opts.fit.min_improvement, label)
     step.constancy.at_range_edge = step.accepted.at_range_edge
     if not (step.constancy.significant or step.constancy.at_range_edge):
         return []
@@ -97,11 +87,7 @@ def discover_step(
     return discover(
         X,
         feats,
-        sim,
-        meas,
-        scales,
-        full.trial_id,
-        train_ids,
+        Gap(sim, meas, scales, full.trial_id, train_ids),
         full.channels,
         opts.alpha,
         opts.fit.min_improvement,

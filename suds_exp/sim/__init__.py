@@ -5,7 +5,7 @@ Public face:
 - `simulate_prescribed(phi, dt, config, pose0, flippers0, n_frames)`: batched physics
   driven by prescribed joint angles (measured or commanded-through-actuator).
 - `simulate_dataset(out_dir, ...)`: gait x frequency x repeat design -> QTM TSV files,
-  truth Parquet files and a manifest.
+  truth Parquet files and a manifest; `SimDesign`, such a design as one value.
 - `effect_library()`, `set_effect(cfg, effect, {param: value})` (or
   `set_effect(cfg, "NAME=VALUE")`), `parse_effect("NAME=VALUE")`, `with_effects(cfg, {...})`.
 - `local_connection(...)`, `save_connection(...)`, `compare_with_hatton(...)`.
@@ -19,6 +19,7 @@ from suds_exp.sim.connection import (
     save_connection,
 )
 from suds_exp.sim.dataset import (
+    SimDesign,
     SimulatedDataset,
     plan_trials,
     simulate_dataset,
@@ -46,6 +47,7 @@ __all__ = [
     "MARKER_NAMES",
     "TRUTH_COLUMNS",
     "SimConfig",
+    "SimDesign",
     "SimulatedDataset",
     "actuate",
     "apply_effects",

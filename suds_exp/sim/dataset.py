@@ -11,7 +11,7 @@ import datetime as _dt
 import math
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
@@ -59,6 +59,52 @@ class SimulatedDataset:
     truth_paths: list[Path]
     manifest: Path
     simulated_seconds: float
+
+
+def check_cycles(cycles: tuple[int, int], text: str | None = None) -> tuple[int, int]:
+    """``cycles`` (MIN, MAX) if 1 <= MIN <= MAX, else a `ConfigError` (quoting ``text``,
+    the string it was read from, when there is one)."""
+    lo, hi = cycles
+    if not 1 <= lo <= hi:
+        shown = repr(text) if text is not None else f"({lo}, {hi})"
+        raise ConfigError(f"cycles {shown}: expected 1 <= MIN <= MAX", param="cycles")
+    return int(lo), int(hi)
+
+
+@dataclass(frozen=True)
+class SimDesign:
+    """A simulated gait x frequency x repeat design, built once and passed through.
+
+    ``gaits``: names of `GAITS`; ``frequencies_hz``: gait frequencies (Hz); ``repeats``:
+    trials per condition; ``cycles``: (MIN, MAX) gait cycles per trial; ``seed``: the
+    seed every trial's randomness derives from; ``changes``: `schedule.Change` items,
+    effects switched on during every trial. Default: the paper's design. Gaits outside
+    `GAITS` and cycles other than 1 <= MIN <= MAX are a `ConfigError`.
+    """
+
+    gaits: tuple[str, ...] = GAITS
+    frequencies_hz: tuple[float, ...] = FREQUENCIES_HZ
+    repeats: int = 4
+    cycles: tuple[int, int] = (10, 30)
+    seed: int = 0
+    changes: tuple = ()
+
+    def __post_init__(self):
+        bad = [g for g in self.gaits if g not in GAITS]
+        if bad or not self.gaits:
+            raise ConfigError(
+                f"gaits {list(self.gaits)!r}: expected some of {', '.join(GAITS)}",
+                param="gaits",
+            )
+        # frozen: the normalised values are set through object's own __setattr__
+        object.__setattr__(self, "gaits", tuple(self.gaits))
+        object.__setattr__(self, "frequencies_hz", tuple(float(f) for f in self.frequencies_hz))
+        object.__setattr__(self, "cycles", check_cycles(tuple(self.cycles)))
+        object.__setattr__(self, "changes", tuple(self.changes))
+
+    def keywords(self) -> dict:
+        """The design as `simulate_dataset`'s keywords."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
 def trial_seed(seed: int, gait: str, frequency_hz: float, repeat: int) -> tuple[int, ...]:

@@ -77,23 +77,9 @@ def _wobble(t: np.ndarray, f: float, tube: float, rng) -> tuple[np.ndarray, np.n
     return e, de
 
 
-def _trial(
-    n_cycles,
-    gait,
-    f,
-    spc,
-    tube,
-    passive,
-    velocity,
-    tau,
-    ell,
-    substeps,
-    rp_start,
-    rng,
-    body_tau,
-    asymmetry=1.0,
-    direction=1,
-):
+def _actuated(n_cycles, gait, f, spc, tube, substeps, rng, direction):
+    """The actuated shape at ``substeps`` points a sample: (t (n,) s, theta (n,) rad,
+    theta_0 rad, r_a (n, 2) rad, dr_a/dt (n, 2) rad/s)."""
     n = int(round(n_cycles * spc))
     fs = f * spc
     nf = n * substeps
@@ -105,22 +91,33 @@ def _trial(
     amp = 1.0 + e[:, :2]
     ra = g * amp + e[:, 2:]
     dra = dg * (2 * np.pi * f) * amp + g * de[:, :2] + de[:, 2:]
+    return tf, theta, theta0, ra, dra
+
+
+def _passive_shape(ra, dra, rate, passive, tau, ell, rp_start):
+    """(r_p, dr_p/dt), each (n, 2) ((n, 0) for ``passive`` "none"), of the actuated shape
+    ``ra``, ``dra`` sampled at ``rate`` Hz."""
+    nf = len(ra)
     if passive == "none":
         rp = np.zeros((nf, 0))
-        drp = rp
-    else:
-        speed = np.linalg.norm(dra, axis=1)
-        lam = np.full(nf, 1.0 / tau) if passive == "lag" else speed / ell
-        forcing = dra @ C_PASSIVE.T + lam[:, None] * (ra @ G_PASSIVE.T)
-        h = 1.0 / (fs * substeps)
-        rp = np.empty((nf, 2))
-        x = ra[0] @ G_PASSIVE.T + rp_start
-        denom = 1.0 + h * lam
-        for i in range(nf):  # implicit Euler: stable whatever tau, exact as h -> 0
-            x = (x + h * forcing[i]) / denom[i]
-            rp[i] = x
-        drp = forcing - lam[:, None] * rp
-    A = connection(ra, rp if passive != "none" else None)
+        return rp, rp
+    speed = np.linalg.norm(dra, axis=1)
+    lam = np.full(nf, 1.0 / tau) if passive == "lag" else speed / ell
+    forcing = dra @ C_PASSIVE.T + lam[:, None] * (ra @ G_PASSIVE.T)
+    h = 1.0 / rate
+    rp = np.empty((nf, 2))
+    x = ra[0] @ G_PASSIVE.T + rp_start
+    denom = 1.0 + h * lam
+    for i in range(nf):  # implicit Euler: stable whatever tau, exact as h -> 0
+        x = (x + h * forcing[i]) / denom[i]
+        rp[i] = x
+    return rp, forcing - lam[:, None] * rp
+
+
+def _body_velocity(ra, dra, rp, rate, velocity, asymmetry, body_tau):
+    """Body velocity (n, 3) (vx, vy mm/s, wz rad/s) of shape ``ra``, ``rp`` and shape
+    velocity ``dra`` sampled at ``rate`` Hz."""
+    A = connection(ra, rp if rp.shape[1] else None)
     if velocity == "asymmetric":
         v = np.einsum("nij,nj->ni", A, np.maximum(dra, 0) + asymmetry * np.minimum(dra, 0))
     else:
@@ -128,11 +125,9 @@ def _trial(
     if velocity == "finsler":
         v += _finsler_bias(ra) * np.linalg.norm(dra, axis=1)[:, None]
     if body_tau > 0:
-        a = -np.expm1(-1.0 / (fs * substeps * body_tau))
+        a = -np.expm1(-1.0 / (rate * body_tau))
         v = lfilter([a], [1.0, a - 1.0], v, axis=0, zi=(1 - a) * v[:1])[0]
-    sl = slice(None, None, substeps)
-    ra, dra, rp, drp, theta, t, v = ra[sl], dra[sl], rp[sl], drp[sl], theta[sl], tf[sl], v[sl]
-    return t, theta - theta0 + (theta0 % (2 * np.pi)), ra, dra, rp, drp, v
+    return v
 
 
 def make_samples(
@@ -177,25 +172,18 @@ def make_samples(
             f"synthetic: velocity={velocity!r}; expected linear, finsler or asymmetric"
         )
     rng = np.random.default_rng(seed)
+    rp_start = np.asarray(rp_start, dtype=float)
     frames = []
     for j in range(n_trials):
-        t, ph, ra, dra, rp, drp, v = _trial(
-            n_cycles,
-            gait,
-            frequency_hz,
-            samples_per_cycle,
-            tube,
-            passive,
-            velocity,
-            tau,
-            ell,
-            substeps,
-            np.asarray(rp_start, dtype=float),
-            rng,
-            body_tau,
-            asymmetry,
-            direction,
+        t, theta, theta0, ra, dra = _actuated(
+            n_cycles, gait, frequency_hz, samples_per_cycle, tube, substeps, rng, direction
         )
+        rate = frequency_hz * samples_per_cycle * substeps
+        rp, drp = _passive_shape(ra, dra, rate, passive, tau, ell, rp_start)
+        v = _body_velocity(ra, dra, rp, rate, velocity, asymmetry, body_tau)
+        sl = slice(None, None, substeps)
+        ra, dra, rp, drp, t, v = ra[sl], dra[sl], rp[sl], drp[sl], t[sl], v[sl]
+        ph = theta[sl] - theta0 + (theta0 % (2 * np.pi))
         n = len(t)
         d = {
             "trial_id": first_trial_id + j,

@@ -96,11 +96,12 @@ class _Clock:
 
 def simulate_step(store: Store, summary: DemoSummary, seed: int, progress, say, lap):
     """Simulate the paper's design into a temporary folder and ingest it."""
+    from suds_exp.sim.dataset import SimDesign
     from suds_exp.workflows.simulate import simulate_and_ingest
 
     with tempfile.TemporaryDirectory(prefix="suds-demo-") as tmp:
         try:
-            run = simulate_and_ingest(store, tmp, seed=seed, progress=progress)
+            run = simulate_and_ingest(store, tmp, design=SimDesign(seed=seed), progress=progress)
         except IngestError as exc:
             # e.g. a database holding another dataset (or an older simulator's) at the
             # same conditions: never overwrite it, say how to run the demo anyway.

@@ -18,6 +18,7 @@ from suds_exp.discrepancy import DiscrepancyOptions, DiscrepancyResult, run_disc
 from suds_exp.discrepancy.effects import main_parameter
 from suds_exp.robot import FREQUENCIES_HZ
 from suds_exp.sim.config import SimConfig
+from suds_exp.sim.dataset import SimDesign
 from suds_exp.sim.effects import set_effect
 
 #: Hidden-effect settings for the checks: (effect, fixed settings, drawn parameter).
@@ -74,31 +75,15 @@ class HiddenRun:
         return None if v is None else float(v)
 
 
-def simulate_measured(
-    workdir: Path,
-    config: SimConfig,
-    seed: int,
-    gaits: Sequence[str],
-    frequencies_hz: Sequence[float],
-    repeats: int,
-    cycles: tuple[int, int],
-):
-    """Simulate a dataset into ``workdir``, ingest and preprocess it; return the store."""
+def simulate_measured(workdir: Path, config: SimConfig, design: SimDesign):
+    """Simulate ``design`` on the robot of ``config`` into ``workdir``, ingest and
+    preprocess it; return the store."""
     from suds_exp.preprocess import preprocess
     from suds_exp.store import Store
     from suds_exp.workflows.simulate import simulate_and_ingest
 
     store = Store(workdir / "suds.duckdb")
-    simulate_and_ingest(
-        store,
-        workdir / "data",
-        config,
-        gaits=gaits,
-        frequencies_hz=frequencies_hz,
-        repeats=repeats,
-        cycles=cycles,
-        seed=seed,
-    )
+    simulate_and_ingest(store, workdir / "data", config, design)
     preprocess(store, "v1", progress=False)
     return store
 
@@ -147,7 +132,8 @@ def hidden_effect_run(
     opts = options or DiscrepancyOptions(seed=seed)
     with tempfile.TemporaryDirectory(prefix="suds-discrepancy-") as tmp:
         base = Path(workdir) if workdir is not None else Path(tmp)
-        store = simulate_measured(base, truth, seed, gaits, frequencies_hz, repeats, cycles)
+        design = SimDesign(tuple(gaits), tuple(frequencies_hz), repeats, cycles, seed)
+        store = simulate_measured(base, truth, design)
         result = run_discrepancy(
             store,
             "v1",
