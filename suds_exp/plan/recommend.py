@@ -74,9 +74,9 @@ VISIT_RADIUS = SHAPE_RADIUS
 #: Starting lags (rad) of the gait search's circles beside the best recorded gait.
 START_LAGS_RAD = (-0.6, 0.0, 0.6)
 #: The look over the whole bound: circles of these radii (fractions of the bound) at
-#: these lags (rad) are scored first, and the search starts from the `GLOBAL_STARTS`
-#: best of them (a grid of the one-harmonic gaits, chosen as the span of amplitude and
-#: tilt, not from any simulated result).
+#: these lags (rad), each traced 1 .. order times a cycle, are scored first, and the
+#: search starts from the `GLOBAL_STARTS` best of them (a grid of single loops, chosen as
+#: the span of amplitude and tilt, not from any simulated result).
 GLOBAL_RADII_OF_BOUND = (0.5, 0.75, 1.0)
 GLOBAL_LAGS_RAD = (-1.2, -0.9, -0.6, -0.3, 0.0, 0.3, 0.6, 0.9, 1.2)
 GLOBAL_STARTS = 2
@@ -410,8 +410,9 @@ def _look_beyond(
     seeds: list[Gait],
 ) -> FourierGait:
     """The gait maximising ``objective`` (mm) within the joint bound alone (rad): the
-    circles of `GLOBAL_RADII_OF_BOUND` x `GLOBAL_LAGS_RAD` and ``seeds`` (Fourier gaits of
-    ``order``; others are left out) are scored, and the search starts from the
+    circles of `GLOBAL_RADII_OF_BOUND` x `GLOBAL_LAGS_RAD`, traced 1 .. ``order`` times a
+    cycle, and ``seeds`` (Fourier gaits of ``order``; others are left out) and the seeds
+    traced again (`traced_starts`) are scored, and the search starts from the
     `GLOBAL_STARTS` best."""
     grid = [
         within_bound(circle(f * bound, order, lag=lag, traces=k), bound)
