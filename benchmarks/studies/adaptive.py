@@ -249,12 +249,13 @@ class DirectTrials:
     """The objective of a black-box peer: each evaluation records one trial of ``cycles``
     cycles of a Fourier gait (the 10 coefficients of ``x``, projected into the bound) and
     returns its measured forward displacement per cycle; the curve's rows follow the best
-    evaluation so far, scored with the gait followed exactly."""
+    evaluation so far, scored with the gait followed exactly, with its coefficients
+    (``best_gait``: a0, cos, sin as `FourierGait.to_vector`, rad) so it can be re-scored."""
 
     def __init__(self, arm: str, seed: int, cycles: int, bound: float):
         self.arm, self.seed, self.cycles, self.bound = arm, seed, cycles, bound
         self.config, self.n, self.best, self.rows = SimConfig(), 0, -np.inf, []
-        self.achieved = np.nan
+        self.achieved, self.best_gait = np.nan, ""
 
     def __call__(self, x: np.ndarray) -> float:
         self.n += 1
@@ -264,7 +265,14 @@ class DirectTrials:
         if value > self.best:
             self.best = value
             self.achieved = float(simulate_forward([gait], FREQ)[0])
-        self.rows.append({"cycles": self.n * self.cycles, "best_forward_mm": self.achieved})
+            self.best_gait = " ".join(f"{v:.6g}" for v in gait.to_vector())
+        self.rows.append(
+            {
+                "cycles": self.n * self.cycles,
+                "best_forward_mm": self.achieved,
+                "best_gait": self.best_gait,
+            }
+        )
         return value
 
 
