@@ -74,8 +74,7 @@ def recorded_cycles(twists: np.ndarray, dt: float, period_s: float) -> np.ndarra
     n = (len(twists) - 1) // per if per > 0 else 0
     if n < 1:
         return np.zeros((0, 3))
-    poses = integrate_twists(twists[: n * per + 1], dt)
-    return relative(poses[: n * per : per], poses[per : n * per + 1 : per])
+    return cycle_motion(integrate_twists(twists[: n * per + 1], dt), per, range(n)).per_cycle
 
 
 def _from_zero(cumulative: np.ndarray) -> np.ndarray:
