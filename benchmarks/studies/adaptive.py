@@ -573,12 +573,22 @@ def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
         fig, ax = plt.subplots(figsize=(7, 4.2))
         if "repeat" not in part:
             part = part.assign(repeat=0)
-        for (arm, seed, _), rows in part.groupby(["arm", "seed", "repeat"], dropna=False):
-            y = rows[column] / ceiling if goal == "gait" else rows[column]
-            style = "o" if len(rows) == 1 else "-"
+        scale = ceiling if goal == "gait" else 1.0
+        for arm, runs in part.groupby("arm", sort=False):
+            colour = colours.get(arm, "k")
+            for _, rows in runs.groupby(["seed", "repeat"], dropna=False):
+                style = "o" if len(rows) == 1 else "-"
+                ax.plot(rows["cycles"], rows[column] / scale, style, color=colour, lw=0.7, alpha=0.3)
+            # the arm's median over every run (seeds and repeats) still within its budget,
+            # each run's curve held at its last value between its own counts
+            table = runs.pivot_table(
+                index="cycles", columns=["seed", "repeat"], values=column, dropna=False
+            ).sort_index()
+            held = table.ffill().where(table.bfill().notna() | table.notna())
+            n = table.shape[1]
             ax.plot(
-                rows["cycles"], y, style, color=colours.get(arm, "k"), alpha=0.8,
-                label=arm if seed == part["seed"].min() else None,
+                held.index, held.median(axis=1) / scale, "o-" if len(held) == 1 else "-",
+                color=colour, lw=2.2, label=f"{arm} (median of {n} runs)",
             )  # fmt: skip
         if goal == "gait":
             for level in (0.8, 0.9):
