@@ -578,7 +578,8 @@ def draw(frame: pd.DataFrame, ceiling: float, out: Path) -> None:
             colour = colours.get(arm, "k")
             for _, rows in runs.groupby(["seed", "repeat"], dropna=False):
                 style = "o" if len(rows) == 1 else "-"
-                ax.plot(rows["cycles"], rows[column] / scale, style, color=colour, lw=0.7, alpha=0.3)
+                y = rows[column] / scale
+                ax.plot(rows["cycles"], y, style, color=colour, lw=0.7, alpha=0.3)
             # the arm's median over every run (seeds and repeats) still within its budget,
             # each run's curve held at its last value between its own counts
             table = runs.pivot_table(
