@@ -481,3 +481,53 @@ def test_the_gait_goal_considers_a_loop_traced_twice_a_cycle(small):
     assert energy[1] > energy[0], (gait.a, gait.b)
     assert rec.predicted_forward_mm > 1.5 * best_value, rec.reason
     assert gait.max_abs() <= 1.2 + 1e-9
+
+
+def test_the_gait_goal_s_spread_counts_the_bias_between_recorded_paths(three_paths, small):
+    # The cycle bootstrap sees the noise of what is recorded, not how much a new gait's
+    # prediction depends on which gaits were recorded; the gait goal's planned trials
+    # missed their predictions by several bootstrap spreads. Its spread adds the path
+    # jackknife's variance (each recorded gait and frequency left out in turn).
+    from suds_exp.gait.design import circle
+    from suds_exp.gait.predict import fit_map
+    from suds_exp.plan import MapEnsemble
+    from suds_exp.preprocess import get_version
+
+    samples = get_version(Store(three_paths), "v1").samples()
+    gait = circle(1.0, 2, lag=0.6)  # no trial ran it
+    boot = MapEnsemble.fit(samples, n_boot=3, seed=0)
+    both = MapEnsemble.fit(samples, n_boot=3, seed=0, paths=True)
+    mean, boot_sd = boot.forward(gait, 0.5)
+    mean_both, sd = both.forward(gait, 0.5)
+    assert mean_both == mean and boot_sd > 0
+    labels = samples["gait"].astype(str)
+    held = np.array([fit_map(samples[labels != g]).forward(gait, 0.5) for g in ("D-", "O", "S-")])
+    jackknife = 2 / 3 * np.sum((held - held.mean()) ** 2)
+    assert sd == pytest.approx(np.sqrt(boot_sd**2 + jackknife), rel=1e-9)
+    assert sd > boot_sd
+    # one recorded path: nothing to leave out, the spread is the bootstrap's
+    one = get_version(Store(small), "v1").samples()
+    alone = MapEnsemble.fit(one, n_boot=3, seed=0, paths=True)
+    assert alone.paths == []
+    assert alone.forward(gait, 0.5) == MapEnsemble.fit(one, n_boot=3, seed=0).forward(gait, 0.5)
+
+
+def test_plan_next_s_gait_spread_counts_the_paths(three_paths, tmp_path, monkeypatch):
+    # what `plan next --goal gait` plans with and reports is the spread with the paths
+    from suds_exp.plan import MapEnsemble
+
+    fits = []
+    real = MapEnsemble.fit.__func__
+
+    def spy(cls, *args, **kw):
+        fits.append(kw.get("paths", args[4] if len(args) > 4 else False))
+        return real(cls, *args, **kw)
+
+    monkeypatch.setattr(MapEnsemble, "fit", classmethod(spy))
+    copy = tmp_path / "db.duckdb"
+    copy.write_bytes(Path(three_paths).read_bytes())
+    advice = plan_next(Store(copy), "v1", "gait", Target.of(bound=1.2), out=tmp_path / "n",
+                       n_boot=2, max_evals=10)  # fmt: skip
+    assert fits == [True]
+    (rec,) = advice.recommendations
+    assert rec.spread_mm > 0

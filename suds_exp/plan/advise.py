@@ -86,7 +86,7 @@ def plan_next(
             f"version {version.name} has no samples; preprocess trials first", step="preprocess"
         )
     key = derive_seed("plan-next", seed, version.id, goal, len(samples))
-    ensemble = MapEnsemble.fit(samples, learner, n_boot, key)
+    ensemble = MapEnsemble.fit(samples, learner, n_boot, key, paths=goal == "gait")
     advice = Advice(version.id, goal, version_cycles(samples))
     if goal == "map":
         bias = bias_variance(samples, target, learner, ensemble.point)

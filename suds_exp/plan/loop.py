@@ -212,7 +212,9 @@ class _State:
         self.version = get_version(store, version.id)
         self.samples = self.version.samples()
         seed = derive_seed("plan-fit", name, it)
-        self.ensemble = MapEnsemble.fit(self.samples, opts.learner, opts.n_boot, seed)
+        # a new gait's spread counts the bias between recorded paths (`MapEnsemble`)
+        paths = opts.goal == "gait"
+        self.ensemble = MapEnsemble.fit(self.samples, opts.learner, opts.n_boot, seed, paths)
         self.support = Support.of(self.samples)
         labels, self.gaits = _recorded_gaits(self.samples, folder)
         freq = target.frequencies_hz[0]

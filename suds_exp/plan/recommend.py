@@ -62,7 +62,13 @@ from suds_exp.gait.predict import fit_map
 from suds_exp.gait.shape import TWO_PI, FourierGait, Gait, paper_gaits, within_bound
 from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns, direction_features
 from suds_exp.models.registry import GMR
-from suds_exp.plan.ensemble import MapEnsemble
+from suds_exp.plan.ensemble import (
+    MapEnsemble,
+    jackknife_variance,
+    leave_path_out,
+    recorded_paths,
+)
+from suds_exp.plan.ensemble import path_hz as _path_hz
 from suds_exp.plan.target import Target
 from suds_exp.robot import FREQUENCIES_HZ
 
@@ -194,21 +200,6 @@ def _displacement(fitted, gait: Gait, frequency_hz: float) -> np.ndarray:
     return np.array([m.forward_mm, m.lateral_mm])
 
 
-def recorded_paths(samples: pd.DataFrame | None) -> list[tuple[str, float]]:
-    """The distinct (gait label, frequency Hz) of the recorded trials, sorted."""
-    if samples is None or samples.empty:
-        return []
-    pairs = samples[["gait", "frequency_hz"]].drop_duplicates()
-    labels = pairs["gait"].astype(str)
-    freqs = [_path_hz(f) for f in pairs["frequency_hz"].astype(float)]
-    return sorted(set(zip(labels, freqs, strict=True)))
-
-
-def _path_hz(frequency_hz: float) -> float:
-    # a path's frequency as stored (6 decimals), so 1/3 Hz planned is 0.333333 recorded
-    return round(float(frequency_hz), 6)
-
-
 def paths_worth(paths: list[tuple[str, float]], frequency_hz: float) -> float:
     """The recorded paths' worth to a target at frequency_hz (Hz): one a distinct gait
     at that frequency, `OTHER_FREQUENCY_WEIGHT` one at another frequency."""
@@ -235,17 +226,11 @@ def bias_variance(
         point = point if point is not None else fit_map(samples, learner)
         return np.array([float(_displacement(point, g, f) @ _displacement(point, g, f))
                          for g, f in pairs])  # fmt: skip
-    labels = samples["gait"].astype(str)
-    freqs = samples["frequency_hz"].astype(float)
     preds = []
-    for label, f in paths:
-        held = (labels == label) & np.isclose(freqs, f)
-        without = fit_map(samples[~held], learner)
-        preds.append([_displacement(without, g, ft) for g, ft in pairs])
-    preds = np.array(preds)  # (k, targets, 2)
-    k = len(paths)
-    dev = preds - preds.mean(axis=0)
-    return (k - 1) / k * np.sum(dev**2, axis=(0, 2))
+    for without in leave_path_out(samples):
+        fitted = fit_map(without, learner)
+        preds.append([_displacement(fitted, g, ft) for g, ft in pairs])
+    return jackknife_variance(np.array(preds)).sum(axis=1)  # (k, targets, 2) -> (targets,)
 
 
 def recommend_map(
