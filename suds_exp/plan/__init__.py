@@ -7,9 +7,9 @@ Public face (the CLI's `plan next | loop` are thin faces on these):
   reason, and the stopping signal (the map goal's forecast for the next doubling).
 - `run_loop(store, LoopOptions(...))` (`loop`): the closed loop with the simulator as the
   robot, every iteration stored (``plan_iterations``); rerunning continues it.
-- `MapEnsemble` (`ensemble`): a learner and its cycle-bootstrap refits, the uncertainty
-  every plan reads; `forecast_signal` (the map goal's stopping signal), `learning_curve`,
-  `target_signal` (`curve`); `Target`,
+- `MapEnsemble` (`ensemble`): a learner, its cycle-bootstrap refits and its
+  path-jackknife refits, the uncertainty every plan reads; `forecast_signal` (the map
+  goal's stopping signal), `learning_curve`, `target_signal` (`curve`); `Target`,
   `unseen_gaits` (`target`).
 """
 

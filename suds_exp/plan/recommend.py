@@ -33,10 +33,13 @@ Two goals:
   the noise, not the bias between paths. The two terms add.
 - ``"gait"``: the best forward displacement per cycle within the bound. The next trial is
   a new Fourier gait (written to a file) that maximises the upper confidence bound
-  (point prediction + `KAPPA` x bootstrap spread) inside the joint bound and inside a
-  trust region around the recorded data (the designer's `optimise_gait`); its reason is
-  the expected improvement over the best recorded gait under a normal prediction. When
-  that step's predicted gain is below its bootstrap spread, the map cannot resolve it: the
+  (point prediction + `KAPPA` x spread) inside the joint bound and inside a trust region
+  around the recorded data (the designer's `optimise_gait`); its reason is the expected
+  improvement over the best recorded gait under a normal prediction. The spread is the
+  bootstrap's and the path jackknife's together (`MapEnsemble.forward` of an ensemble
+  fitted with ``paths=True``): the bootstrap alone does not see how much a new gait's
+  prediction depends on which gaits were recorded. When that step's predicted gain is
+  below its spread, the map cannot resolve it: the
   trust-region search has converged on a local optimum of the map as learned so far. The
   same bound is then searched whole (`_look_beyond`; the refits' spread grows away from
   the data, so the upper bound rewards exploring where the map has not been told), and
