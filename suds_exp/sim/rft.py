@@ -130,11 +130,7 @@ def _newton(x, fixed, eps, tol, max_iter, work):
 
     Trial points are assembled with their Jacobian, so an accepted full step costs one
     assembly."""
-    R = work[0]
-    Rt = work[1]
-    dx = work[2]
-    xt = work[3]
-    qh = work[4]
+    R, Rt, dx, xt, qh = work[0], work[1], work[2], work[3], work[4]
     J = np.empty((N_UNKNOWN, N_UNKNOWN))
     Jt = np.empty((N_UNKNOWN, N_UNKNOWN))
     _assemble(x, fixed, eps, R, J, True, qh)
@@ -187,11 +183,7 @@ def _newton(x, fixed, eps, tol, max_iter, work):
 def _lm(x, fixed, eps, tol, max_iter, work):
     """Levenberg-Marquardt on |R|^2 from x (in place): slower than Newton but does not
     stall on the plateaus of the saturating law. Returns (residual norm, iterations)."""
-    R = work[0]
-    Rt = work[1]
-    dx = work[2]
-    xt = work[3]
-    qh = work[4]
+    R, Rt, dx, xt, qh = work[0], work[1], work[2], work[3], work[4]
     J = np.empty((N_UNKNOWN, N_UNKNOWN))
     Jd = np.empty((N_UNKNOWN, N_UNKNOWN))
     A = np.empty((N_UNKNOWN, N_UNKNOWN))
