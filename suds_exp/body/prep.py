@@ -33,7 +33,7 @@ from suds_exp.errors import PreprocessError
 from suds_exp.preprocess.clean import clean_tracks
 from suds_exp.preprocess.params import DEFAULTS, params_hash, resolve_params
 from suds_exp.preprocess.phaser import Phaser, cycles
-from suds_exp.preprocess.pipeline import PLANAR_Z, new_result, preprocess
+from suds_exp.preprocess.pipeline import PLANAR_Z, new_result, preprocess, trial_meta
 from suds_exp.preprocess.rates import body_velocity, derivative, differentiator_window
 from suds_exp.preprocess.shape import PassivePCA
 from suds_exp.preprocess.tables import (
@@ -50,7 +50,6 @@ from suds_exp.preprocess.version import (
 )
 from suds_exp.progress import progress_bar
 from suds_exp.store import Store
-from suds_exp.store.tables import trials
 
 
 def preprocess_body(
@@ -168,18 +167,7 @@ def _locked_chain(store, body, name, params, trials_, progress) -> PrepResult:
 
 
 def _chain_meta(conn: sa.Connection, trial_ids) -> pd.DataFrame:
-    query = sa.select(
-        trials.c.id, trials.c.source_file, trials.c.sample_rate_hz, trials.c.marker_names
-    ).order_by(trials.c.id)
-    meta = Store.frame(conn, query)
-    if trial_ids is not None:
-        wanted = sorted({int(i) for i in trial_ids})
-        unknown = sorted(set(wanted) - {int(i) for i in meta.id})
-        if unknown:
-            raise PreprocessError(
-                f"trials: no trial with id {', '.join(map(str, unknown))}", param="trials"
-            )
-        meta = meta[meta.id.isin(wanted)]
+    meta = trial_meta(conn, trial_ids, ("id", "source_file", "sample_rate_hz", "marker_names"))
     if meta.empty:
         raise PreprocessError("no trials to preprocess; ingest some first", step="ingest")
     return meta

@@ -491,9 +491,7 @@ def _store_iteration(store: Store, design_id: int, it: Iteration) -> None:
 
 def load_design(store: Store, design_id: int) -> pd.DataFrame:
     """The stored iterations of design ``design_id``, in order (one row each)."""
-    with store.read() as conn:
-        return Store.frame(
-            conn,
-            "SELECT * FROM gait_design_iterations WHERE design_id = ? ORDER BY iteration",
-            [int(design_id)],
-        )
+    return store.query_df(
+        "SELECT * FROM gait_design_iterations WHERE design_id = ? ORDER BY iteration",
+        [int(design_id)],
+    )

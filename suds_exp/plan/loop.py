@@ -669,9 +669,6 @@ def _store_iteration(store: Store, loop_id: int, it: LoopIteration) -> None:
 
 def load_loop(store: Store, loop_id: int) -> pd.DataFrame:
     """The stored iterations of loop ``loop_id``, in order (one row each)."""
-    with store.read() as conn:
-        return Store.frame(
-            conn,
-            "SELECT * FROM plan_iterations WHERE loop_id = ? ORDER BY iteration",
-            [int(loop_id)],
-        )
+    return store.query_df(
+        "SELECT * FROM plan_iterations WHERE loop_id = ? ORDER BY iteration", [int(loop_id)]
+    )

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -126,17 +126,17 @@ def _read_tracks(conn: sa.Connection, meta: pd.DataFrame, model: BodyModel) -> d
     return out
 
 
-def _trial_meta(conn: sa.Connection, trial_ids: Iterable[int] | None) -> pd.DataFrame:
+#: The columns of `trials` the standard pipeline reads.
+META_COLUMNS = ("id", "source_file", "gait", "frequency_hz", "sample_rate_hz", "n_frames", "layout")
+
+
+def trial_meta(
+    conn: sa.Connection, trial_ids: Iterable[int] | None, columns: Sequence[str] = META_COLUMNS
+) -> pd.DataFrame:
+    """The rows of `trials` with ids ``trial_ids`` (None: every trial), by id, with
+    ``columns``; a `PreprocessError` names any id the store does not hold."""
     wanted = None if trial_ids is None else sorted({int(i) for i in trial_ids})
-    query = sa.select(
-        trials.c.id,
-        trials.c.source_file,
-        trials.c.gait,
-        trials.c.frequency_hz,
-        trials.c.sample_rate_hz,
-        trials.c.n_frames,
-        trials.c.layout,
-    ).order_by(trials.c.id)
+    query = sa.select(*(trials.c[c] for c in columns)).order_by(trials.c.id)
     meta = Store.frame(conn, query)
     if wanted is not None:
         unknown = sorted(set(wanted) - set(int(i) for i in meta.id))
@@ -306,7 +306,7 @@ def _preprocess(store, name, params, trials, progress, started, model) -> PrepRe
     digest = params_hash(params)
     with store.write() as conn:
         row = find_version(conn, name, digest)
-        meta = _trial_meta(conn, trials)
+        meta = trial_meta(conn, trials)
         done, fits = stored_progress(conn, None if row is None else row.id)
         todo = meta[~meta.id.isin(done)]
         tracks = _read_tracks(conn, todo, model) if len(todo) else {}
@@ -346,7 +346,7 @@ def clean(
     progress: bool,
     model: BodyModel | None = None,
 ):
-    """Clean and measure every trial of ``todo`` (rows of `_trial_meta`, their tracks from
+    """Clean and measure every trial of ``todo`` (rows of `trial_meta`, their tracks from
     `_read_tracks`); any refusal raises `PreprocessError` before anything is written."""
     model = SwimmerModel() if model is None else model
     items: list[_Trial] = []

@@ -117,19 +117,23 @@ def _norm(v):
 
 
 @njit(cache=True)
-def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, max_iter, work):
+def _assemble(x, fixed, eps, R, J, want_j, qh):
+    """`assemble` at x and smoothing scale eps; ``fixed`` holds what stays put during a
+    solve, (geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge)."""
+    geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge = fixed
+    assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, want_j, qh)
+
+
+@njit(cache=True)
+def _newton(x, fixed, eps, tol, max_iter, work):
     """Damped Newton from x (modified in place). Returns (residual norm, iterations).
 
     Trial points are assembled with their Jacobian, so an accepted full step costs one
     assembly."""
-    R = work[0]
-    Rt = work[1]
-    dx = work[2]
-    xt = work[3]
-    qh = work[4]
+    R, Rt, dx, xt, qh = work[0], work[1], work[2], work[3], work[4]
     J = np.empty((N_UNKNOWN, N_UNKNOWN))
     Jt = np.empty((N_UNKNOWN, N_UNKNOWN))
-    assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+    _assemble(x, fixed, eps, R, J, True, qh)
     nr = _norm(R)
     it = 0
     while nr > tol and it < max_iter:
@@ -152,22 +156,7 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
         while t > 1e-3:
             for i in range(N_UNKNOWN):
                 xt[i] = x[i] + t * dx[i]
-            assemble(
-                xt,
-                geo,
-                el_w,
-                el_part,
-                prm,
-                eps,
-                normal_fac,
-                held,
-                ang,
-                c_hinge,
-                Rt,
-                Jt,
-                t == 1.0,
-                qh,
-            )
+            _assemble(xt, fixed, eps, Rt, Jt, t == 1.0, qh)
             nt = _norm(Rt)
             if nt <= (1.0 - 1e-4 * t) * nr:
                 accepted = True
@@ -175,9 +164,7 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
             t *= 0.25
         if not accepted:
             # stalled at a kink of the smoothed law: the caller continues on eps
-            assemble(
-                x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh
-            )
+            _assemble(x, fixed, eps, R, J, True, qh)
             return nr, it
         for i in range(N_UNKNOWN):
             x[i] = xt[i]
@@ -187,27 +174,21 @@ def _newton(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol
                 for j in range(N_UNKNOWN):
                     J[i, j] = Jt[i, j]
         else:
-            assemble(
-                x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh
-            )
+            _assemble(x, fixed, eps, R, J, True, qh)
         nr = _norm(R)
     return nr, it
 
 
 @njit(cache=True)
-def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, max_iter, work):
+def _lm(x, fixed, eps, tol, max_iter, work):
     """Levenberg-Marquardt on |R|^2 from x (in place): slower than Newton but does not
     stall on the plateaus of the saturating law. Returns (residual norm, iterations)."""
-    R = work[0]
-    Rt = work[1]
-    dx = work[2]
-    xt = work[3]
-    qh = work[4]
+    R, Rt, dx, xt, qh = work[0], work[1], work[2], work[3], work[4]
     J = np.empty((N_UNKNOWN, N_UNKNOWN))
     Jd = np.empty((N_UNKNOWN, N_UNKNOWN))
     A = np.empty((N_UNKNOWN, N_UNKNOWN))
     g = np.empty(N_UNKNOWN)
-    assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+    _assemble(x, fixed, eps, R, J, True, qh)
     nr = _norm(R)
     lam = 1e-6
     it = 0
@@ -232,22 +213,7 @@ def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, ma
             if _lin_solve(Jd, g, dx):
                 for i in range(N_UNKNOWN):
                     xt[i] = x[i] + dx[i]
-                assemble(
-                    xt,
-                    geo,
-                    el_w,
-                    el_part,
-                    prm,
-                    eps,
-                    normal_fac,
-                    held,
-                    ang,
-                    c_hinge,
-                    Rt,
-                    J,
-                    False,
-                    qh,
-                )
+                _assemble(xt, fixed, eps, Rt, J, False, qh)
                 nt = _norm(Rt)
                 if nt < nr:
                     improved = True
@@ -258,7 +224,7 @@ def _lm(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, ma
         lam = max(lam / 5.0, 1e-9)
         for i in range(N_UNKNOWN):
             x[i] = xt[i]
-        assemble(x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, R, J, True, qh)
+        _assemble(x, fixed, eps, R, J, True, qh)
         nr = _norm(R)
     return nr, it
 
@@ -271,18 +237,15 @@ def _solve_step(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge, work
     eps = prm[P_EPS]
     tol = prm[P_TOL]
     max_iter = int(prm[P_MAXIT])
+    fixed = (geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge)
     x0 = work[5]
     for i in range(N_UNKNOWN):
         x0[i] = x[i]
-    nr, it = _newton(
-        x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, max_iter, work
-    )
+    nr, it = _newton(x, fixed, eps, tol, max_iter, work)
     if nr <= tol:
         return nr, it, False
     total = it
-    nr, it = _lm(
-        x, geo, el_w, el_part, prm, eps, normal_fac, held, ang, c_hinge, tol, 4 * max_iter, work
-    )
+    nr, it = _lm(x, fixed, eps, tol, 4 * max_iter, work)
     total += it
     if nr <= tol:
         return nr, total, True
@@ -296,16 +259,10 @@ def _solve_step(x, geo, el_w, el_part, prm, normal_fac, held, ang, c_hinge, work
         factor = 3.1622776601683795 if attempt < 2 else 1.5
         mult = 1000.0
         while mult > 0.9:
-            nr, it = _newton(
-                x, geo, el_w, el_part, prm, eps * mult, normal_fac, held, ang, c_hinge,
-                tol, max_iter, work,
-            )  # fmt: skip
+            nr, it = _newton(x, fixed, eps * mult, tol, max_iter, work)
             total += it
             if nr > tol:
-                nr, it = _lm(
-                    x, geo, el_w, el_part, prm, eps * mult, normal_fac, held, ang, c_hinge,
-                    tol, 4 * max_iter, work,
-                )  # fmt: skip
+                nr, it = _lm(x, fixed, eps * mult, tol, 4 * max_iter, work)
                 total += it
             mult /= factor
         if nr < best:
