@@ -48,8 +48,7 @@ def planned_trials(work: Path) -> pd.DataFrame:
     measured (mm per cycle), beyond (a look beyond the trust region), best_before (the
     furthest any earlier trial of the loop went, mm per cycle)."""
     store = Store(work / "plan.duckdb")
-    with store.read() as conn:
-        loops = Store.frame(conn, "SELECT id, name, prep_version FROM plan_loops WHERE goal = 'gait'")
+    loops = store.query_df("SELECT id, name, prep_version FROM plan_loops WHERE goal = 'gait'")
     rows = []
     for loop in loops.itertuples():
         iterations = load_loop(store, int(loop.id))
