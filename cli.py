@@ -1207,8 +1207,8 @@ def plan_loop_cmd(
     from suds_exp.commands.plan import iteration_line, loop_command, loop_lines, loop_options
     from suds_exp.commands.simulate import build_config
 
-    model = either(model, learner)
-    options = loop_options(goal, bound, budget_cycles, seed, cycles, model, target, freqs)
+    recipe = dict(goal=goal, bound=bound, budget_cycles=budget_cycles, seed=seed, cycles=cycles)
+    options = loop_options(target, freqs, learner=either(model, learner), **recipe)
     say = None if (json_ or quiet) else (lambda it: console.out.print(iteration_line(it)))
     doc = loop_command(
         open_store(db),
