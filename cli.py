@@ -108,14 +108,18 @@ app = typer.Typer(
     cls=Group,
 )
 
+
+def option(help: str, *flags: str, metavar: str | None = None, **kwargs):
+    """`typer.Option` with its help first, so that a declaration fits one line."""
+    return typer.Option(*flags, help=help, metavar=metavar, **kwargs)
+
+
 DbOption = Annotated[
     Path | None,
-    typer.Option(
-        "--db", envvar="SUDS_DB", help="DuckDB file (default: ./suds.duckdb, or $SUDS_DB)."
-    ),
+    option("DuckDB file (default: ./suds.duckdb, or $SUDS_DB).", "--db", envvar="SUDS_DB"),
 ]
-JsonOption = Annotated[bool, typer.Option("--json", help="Print one JSON document on stdout.")]
-CsvOption = Annotated[bool, typer.Option("--csv", help="Print the table as CSV on stdout.")]
+JsonOption = Annotated[bool, option("Print one JSON document on stdout.", "--json")]
+CsvOption = Annotated[bool, option("Print the table as CSV on stdout.", "--csv")]
 
 
 def old_name(flag: str, new: str):
@@ -129,12 +133,7 @@ def either(value, old):
     return value if old is None else old
 
 
-QuietOption = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")]
-
-
-def option(help: str, *flags: str, metavar: str | None = None, **kwargs):
-    """`typer.Option` with its help first, so that a declaration fits one line."""
-    return typer.Option(*flags, help=help, metavar=metavar, **kwargs)
+QuietOption = Annotated[bool, option("No progress bar.", "--quiet", "-q")]
 
 
 # Options that several commands take: declared once, so that they are named, written and
@@ -224,9 +223,7 @@ def _print_version(value: bool) -> None:
 def main(
     version: Annotated[
         bool,
-        typer.Option(
-            "--version", callback=_print_version, is_eager=True, help="Print the version and exit."
-        ),
+        option("Print the version and exit.", "--version", callback=_print_version, is_eager=True),
     ] = False,
 ) -> None:
     # the options of `suds-exp` itself, before any command; the help text is the app's
@@ -267,29 +264,25 @@ def init(db: DbOption = None, json_: JsonOption = False) -> None:
 @command()
 def ingest(
     paths: Annotated[list[Path] | None, typer.Argument(help="Capture files or folders.")] = None,
-    manifest: Annotated[
-        Path | None, typer.Option(help="CSV file,gait,frequency_hz,repeat,notes.")
-    ] = None,
-    layout: Annotated[Path | None, typer.Option(help="CSV role,marker for the 11 roles.")] = None,
+    manifest: Annotated[Path | None, option("CSV file,gait,frequency_hz,repeat,notes.")] = None,
+    layout: Annotated[Path | None, option("CSV role,marker for the 11 roles.")] = None,
     software: Annotated[
         str | None,
-        typer.Option(
-            help="Keypoint files' tracker: deeplabcut, sleap, lightning-pose, anipose "
+        option(
+            "Keypoint files' tracker: deeplabcut, sleap, lightning-pose, anipose "
             "(default: told by the file)."
         ),
     ] = None,
     fps: Annotated[
-        float | None, typer.Option(help="Keypoint files' frame rate, when the file lacks it.")
+        float | None, option("Keypoint files' frame rate, when the file lacks it.")
     ] = None,
-    mm_per_px: Annotated[
-        float | None, typer.Option(help="Scale of 2-D keypoints, mm per pixel.")
-    ] = None,
+    mm_per_px: Annotated[float | None, option("Scale of 2-D keypoints, mm per pixel.")] = None,
     confidence_threshold: Annotated[
         float | None,
-        typer.Option(help="Keypoints below this confidence are missing (default 0.6)."),
+        option("Keypoints below this confidence are missing (default 0.6)."),
     ] = None,
     experiment: Annotated[
-        Path | None, typer.Option(help="TOML of the condition axes (default: the paper's).")
+        Path | None, option("TOML of the condition axes (default: the paper's).")
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -389,25 +382,25 @@ SimConfigOption = Annotated[
 
 @command(flags={"frequencies_hz": "--freqs"})
 def simulate(
-    out: Annotated[Path, typer.Option(help="Folder for TSV, truth Parquet and manifest.")],
+    out: Annotated[Path, option("Folder for TSV, truth Parquet and manifest.")],
     config: SimConfigOption = None,
     gaits: Annotated[
-        str | None, typer.Option(help="Comma list, e.g. S+,O (default: all five).", metavar="GAITS")
+        str | None, option("Comma list, e.g. S+,O (default: all five).", metavar="GAITS")
     ] = None,
     freqs: Annotated[
-        str | None, typer.Option(help="Hz, comma list (default: 1/3,1/2,1).", metavar="HZ,...")
+        str | None, option("Hz, comma list (default: 1/3,1/2,1).", metavar="HZ,...")
     ] = None,
-    repeats: Annotated[int, typer.Option(help="Trials per condition.")] = 4,
+    repeats: Annotated[int, option("Trials per condition.")] = 4,
     cycles: Annotated[
         str | None,
-        typer.Option(help="Cycles per trial MIN:MAX (default: 10:30).", metavar="MIN:MAX"),
+        option("Cycles per trial MIN:MAX (default: 10:30).", metavar="MIN:MAX"),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Same seed, same files.")] = 0,
+    seed: Annotated[int, option("Same seed, same files.")] = 0,
     effect: ScheduleOption = None,
-    ingest: Annotated[bool, typer.Option("--ingest", help="Ingest the result into --db.")] = False,
+    ingest: Annotated[bool, option("Ingest the result into --db.", "--ingest")] = False,
     gait_file: Annotated[
         Path | None,
-        typer.Option(help="A gait file (CSV phase_rad,phi1_rad,phi2_rad or Fourier TOML)."),
+        option("A gait file (CSV phase_rad,phi1_rad,phi2_rad or Fourier TOML)."),
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -447,10 +440,10 @@ def simulate(
 
 @command(flags={"half_range": "--range"})
 def connection(
-    out: Annotated[Path, typer.Option(help="CSV file; figures go beside it (_vx/_vy/_wz.png).")],
+    out: Annotated[Path, option("CSV file; figures go beside it (_vx/_vy/_wz.png).")],
     grid: GridOption = 21,
     range_: RangeOption = 2.5,
-    geometry: Annotated[str, typer.Option(help="robot or classic (3 equal links).")] = "robot",
+    geometry: Annotated[str, option("robot or classic (3 equal links).")] = "robot",
     config: SimConfigOption = None,
     effect: EffectOption = None,
     json_: JsonOption = False,
@@ -501,28 +494,24 @@ def effects(
 
 @command()
 def preprocess(
-    name: Annotated[
-        str | None, typer.Option(help="Name of a new version (default: v<id>).")
-    ] = None,
+    name: Annotated[str | None, option("Name of a new version (default: v<id>).")] = None,
     param: Annotated[
         list[str] | None,
-        typer.Option(
-            "--param", help="KEY=VALUE over the defaults; repeatable.", metavar="KEY=VALUE"
-        ),
+        option("KEY=VALUE over the defaults; repeatable.", "--param", metavar="KEY=VALUE"),
     ] = None,
     trials_: TrialsOption = None,
-    list_: Annotated[bool, typer.Option("--list", help="List the versions and exit.")] = False,
+    list_: Annotated[bool, option("List the versions and exit.", "--list")] = False,
     body: Annotated[
         str | None,
-        typer.Option(help="Body description: a TOML file, or 'swimmer' (the default body)."),
+        option("Body description: a TOML file, or 'swimmer' (the default body)."),
     ] = None,
     preset: Annotated[
         str | None,
-        typer.Option(help="Named parameter set under --param: default | paper (the paper's own)."),
+        option("Named parameter set under --param: default | paper (the paper's own)."),
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
-    csv: Annotated[bool, typer.Option("--csv", help="With --list: the versions as CSV.")] = False,
+    csv: Annotated[bool, option("With --list: the versions as CSV.", "--csv")] = False,
     quiet: QuietOption = False,
 ) -> None:
     """Turn markers into samples (shape, phase, body velocity) as a stored version.
@@ -558,25 +547,24 @@ def preprocess(
 
 CampaignModelsOption = Annotated[
     str | None,
-    typer.Option(
-        help="Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
+    option(
+        "Learners, comma-separated (default: the paper's five); MLP, GBT, kNN, KRR "
         "(+SUDS), sklearn:ClassName (+SUDS); survey = the five and the baselines.",
         metavar="LEARNERS",
     ),
 ]
 ModelParamOption = Annotated[
     list[str] | None,
-    typer.Option(
-        help="NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01.",
-        metavar="NAME.KEY=VALUE",
+    option(
+        "NAME.KEY=VALUE for a learner of --models, e.g. MLP.alpha=0.01.", metavar="NAME.KEY=VALUE"
     ),
 ]
 SkipInfeasibleOption = Annotated[
     bool | None,
-    typer.Option(
-        "--skip-infeasible/--no-skip-infeasible",
-        help="Leave out the (condition, training size) cells the data cannot supply "
+    option(
+        "Leave out the (condition, training size) cells the data cannot supply "
         "instead of refusing the campaign; stored in its definition.",
+        "--skip-infeasible/--no-skip-infeasible",
     ),
 ]
 
@@ -586,42 +574,35 @@ def run(
     name: Annotated[str, typer.Argument(help="Campaign name (created, or continued).")],
     prep: PrepOption = None,
     models: CampaignModelsOption = None,
-    boots: Annotated[
-        int | None, typer.Option(help="Draws per (train, test) pair (default 10).")
-    ] = None,
+    boots: Annotated[int | None, option("Draws per (train, test) pair (default 10).")] = None,
     train_cycles: Annotated[
-        int | None, typer.Option(help="Training (and test) cycles of the main grid (default 30).")
+        int | None, option("Training (and test) cycles of the main grid (default 30).")
     ] = None,
     sweep: Annotated[
         str | None,
-        typer.Option(
-            help="Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper.",
+        option(
+            "Sample-efficiency sweep on same-condition pairs: 1-10,21,48 or paper.",
             metavar="CYCLES",
         ),
     ] = None,
     train_conditions: Annotated[
         str | None,
-        typer.Option(
-            help="GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).",
-            metavar="CONDITIONS",
-        ),
+        option("GAIT@FREQ, GAIT or @FREQ, comma-separated (default: all).", metavar="CONDITIONS"),
     ] = None,
     test_conditions: Annotated[
-        str | None, typer.Option(help="As --train-conditions.", metavar="CONDITIONS")
+        str | None, option("As --train-conditions.", metavar="CONDITIONS")
     ] = None,
     mode: Annotated[
         str | None,
-        typer.Option(help="SUDS learners: measured or rollout (default measured).", metavar="MODE"),
+        option("SUDS learners: measured or rollout (default measured).", metavar="MODE"),
     ] = None,
     model_param: ModelParamOption = None,
     skip_infeasible: SkipInfeasibleOption = None,
     jobs: JobsOption = 1,
-    backend: Annotated[
-        str, typer.Option(help="loky (this machine) or dask.", metavar="NAME")
-    ] = "loky",
+    backend: Annotated[str, option("loky (this machine) or dask.", metavar="NAME")] = "loky",
     scheduler: Annotated[
         str | None,
-        typer.Option(help="dask scheduler address, e.g. tcp://host:8786.", metavar="URL"),
+        option("dask scheduler address, e.g. tcp://host:8786.", metavar="URL"),
     ] = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -673,20 +654,17 @@ def survey(
     name: Annotated[
         str, typer.Argument(help="Campaign with a --sweep and/or a main grid of cross pairs.")
     ],
-    cycles: Annotated[int, typer.Option(help="Main grid size: GMR's error target.")] = 30,
-    versus: Annotated[
-        str, typer.Option(help="Learner whose data need is set against GMR's.")
-    ] = "MLP",
-    boots: Annotated[int, typer.Option(help="Bootstrap resamples of the ratio.")] = 1000,
+    cycles: Annotated[int, option("Main grid size: GMR's error target.")] = 30,
+    versus: Annotated[str, option("Learner whose data need is set against GMR's.")] = "MLP",
+    boots: Annotated[int, option("Bootstrap resamples of the ratio.")] = 1000,
     n_boot: Annotated[int | None, old_name("--n-boot", "--boots")] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     csv: CsvOption = False,
     table: Annotated[
         str | None,
-        typer.Option(
-            help="With --csv: cycles (cycles to target, the default) | timing | glm.",
-            show_default=False,
+        option(
+            "With --csv: cycles (cycles to target, the default) | timing | glm.", show_default=False
         ),
     ] = None,
 ) -> None:
@@ -742,23 +720,21 @@ def status(
 @command(flags={"n_cycles": "--cycles", "paper_dir": "--paper", "n_boot": "--boots"})
 def report(
     name: CampaignArgument,
-    out: Annotated[Path | None, typer.Option(help="Folder (default: reports/NAME).")] = None,
+    out: Annotated[Path | None, option("Folder (default: reports/NAME).")] = None,
     cycles: Annotated[
-        int | None, typer.Option(help="Training size of box plots and GLMs (default: most common).")
+        int | None, option("Training size of box plots and GLMs (default: most common).")
     ] = None,
     pairs: Annotated[
-        str, typer.Option(help="Spread/efficiency pairs: same-condition or same-frequency.")
+        str, option("Spread/efficiency pairs: same-condition or same-frequency.")
     ] = "same-condition",
     paper: Annotated[
-        Path | None, typer.Option(help="Folder of the paper's glm_table.csv and iqr_table.csv.")
+        Path | None, option("Folder of the paper's glm_table.csv and iqr_table.csv.")
     ] = None,
     experiment: Annotated[
         Path | None,
-        typer.Option(help="TOML of the condition axes (default: the one stored at ingest)."),
+        option("TOML of the condition axes (default: the one stored at ingest)."),
     ] = None,
-    boots: Annotated[
-        int, typer.Option(help="Bootstrap replicates of the findings' intervals.")
-    ] = 400,
+    boots: Annotated[int, option("Bootstrap replicates of the findings' intervals.")] = 400,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -793,16 +769,16 @@ def report(
 @command(flags={"n_boot": "--boots"})
 def findings(
     name: CampaignArgument,
-    boots: Annotated[int, typer.Option(help="Bootstrap replicates of the intervals.")] = 400,
+    boots: Annotated[int, option("Bootstrap replicates of the intervals.")] = 400,
     boot: BootAlias = None,
-    seed: Annotated[int, typer.Option(help="Seed of the bootstrap replicates.")] = 0,
+    seed: Annotated[int, option("Seed of the bootstrap replicates.")] = 0,
     db: DbOption = None,
     json_: JsonOption = False,
     csv: CsvOption = False,
     table: Annotated[
         str | None,
-        typer.Option(
-            help="With --csv: findings (the default) | passive (what the passive shape adds) "
+        option(
+            "With --csv: findings (the default) | passive (what the passive shape adds) "
             "| momentum (what the velocity history adds).",
             show_default=False,
         ),
@@ -834,27 +810,25 @@ def discrepancy(
     model_effect: Annotated[list[str] | None, old_name("--model-effect", "--effect")] = None,
     trials: TrialsOption = None,
     prep: PrepOption = None,
-    alpha: Annotated[float, typer.Option(help="Level of the test naming an effect.")] = 0.01,
-    max_effects: Annotated[int, typer.Option(help="Stop after naming this many.")] = 3,
-    seed: Annotated[int, typer.Option(help="Seed of the trial split and bootstraps.")] = 0,
-    name: Annotated[
-        str | None, typer.Option(help="Run name (default: discrepancy-<time>).")
-    ] = None,
+    alpha: Annotated[float, option("Level of the test naming an effect.")] = 0.01,
+    max_effects: Annotated[int, option("Stop after naming this many.")] = 3,
+    seed: Annotated[int, option("Seed of the trial split and bootstraps.")] = 0,
+    name: Annotated[str | None, option("Run name (default: discrepancy-<time>).")] = None,
     out: Annotated[
-        Path | None, typer.Option(help="Report folder (default: reports/discrepancy-NAME).")
+        Path | None, option("Report folder (default: reports/discrepancy-NAME).")
     ] = None,
     exclude_candidates: Annotated[
         str | None,
-        typer.Option(help="Comma list of effects never offered as candidates."),
+        option("Comma list of effects never offered as candidates."),
     ] = None,
     discover: Annotated[
         bool,
-        typer.Option(
+        option(
+            "Fit a sparse learned correction when no candidate explains a systematic gap.",
             "--discover/--no-discover",
-            help="Fit a sparse learned correction when no candidate explains a systematic gap.",
         ),
     ] = True,
-    max_terms: Annotated[int, typer.Option(help="Most terms per channel of that correction.")] = 4,
+    max_terms: Annotated[int, option("Most terms per channel of that correction.")] = 4,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -889,7 +863,7 @@ def discrepancy(
 @command()
 def demo(
     db: DbOption = None,
-    out: Annotated[Path, typer.Option(help="Folder for the campaign report.")] = Path("reports"),
+    out: Annotated[Path, option("Folder for the campaign report.")] = Path("reports"),
     jobs: JobsOption = 2,
     quiet: QuietOption = False,
     json_: JsonOption = False,
@@ -923,20 +897,16 @@ def stream(
     name: Annotated[str, typer.Argument(help="Stream name (created, or continued).")],
     models: Annotated[
         str,
-        typer.Option(
-            help="Learners, comma-separated; online ones keep learning.", metavar="LEARNERS"
-        ),
+        option("Learners, comma-separated; online ones keep learning.", metavar="LEARNERS"),
     ] = "GMR,OnlineGMR",
     trials_: TrialsOption = None,
     prep: PrepOption = None,
-    warmup: Annotated[int, typer.Option(help="Cycles that train before scoring starts.")] = 10,
+    warmup: Annotated[int, option("Cycles that train before scoring starts.")] = 10,
     change_at: Annotated[
         str | None,
-        typer.Option(help="Change time (s) of every trial (default: the simulator's schedule)."),
+        option("Change time (s) of every trial (default: the simulator's schedule)."),
     ] = None,
-    plot: Annotated[
-        Path | None, typer.Option(help="Write the error-against-time figure here (PNG).")
-    ] = None,
+    plot: Annotated[Path | None, option("Write the error-against-time figure here (PNG).")] = None,
     db: DbOption = None,
     json_: JsonOption = False,
     quiet: QuietOption = False,
@@ -983,7 +953,7 @@ app.add_typer(gait_app, name="gait")
 def gait_predict(
     gait_file: Annotated[
         Path,
-        typer.Option(help="CSV phase_rad,<joint>_rad,... or TOML; one column per actuated joint."),
+        option("CSV phase_rad,<joint>_rad,... or TOML; one column per actuated joint."),
     ],
     freqs: FreqOption = "1/2",
     freq: FreqAlias = None,
@@ -991,11 +961,9 @@ def gait_predict(
     model: ModelOption = "GMR",
     learner: LearnerAlias = None,
     trials_: TrialsOption = None,
-    boots: Annotated[
-        int, typer.Option(help="Bootstrap refits for the 95 % intervals: 0 (none) or 40+.")
-    ] = 40,
+    boots: Annotated[int, option("Bootstrap refits for the 95 % intervals: 0 (none) or 40+.")] = 40,
     boot: BootAlias = None,
-    bound: Annotated[float, typer.Option(help="Joint bound the gait must keep, rad.")] = 2.0,
+    bound: Annotated[float, option("Joint bound the gait must keep, rad.")] = 2.0,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -1031,20 +999,20 @@ def gait_predict(
 
 @command(on=gait_app, name="design", flags={"frequency_hz": "--freqs", "learner": "--model"})
 def gait_design(
-    bound: Annotated[float, typer.Option(help="Joint bound |angle| <= RAD, every joint.")] = 1.3,
-    iterations: Annotated[int, typer.Option(help="Design iterations.")] = 5,
+    bound: Annotated[float, option("Joint bound |angle| <= RAD, every joint.")] = 1.3,
+    iterations: Annotated[int, option("Design iterations.")] = 5,
     verify: Annotated[
-        bool, typer.Option("--verify", help="Run each design on the simulator and learn it.")
+        bool, option("Run each design on the simulator and learn it.", "--verify")
     ] = False,
     prep: PrepOption = None,
     model: ModelOption = "GMR",
     learner: LearnerAlias = None,
     freqs: FreqOption = "1/2",
     freq: FreqAlias = None,
-    order: Annotated[int, typer.Option(help="Fourier harmonics per joint.")] = 2,
-    out: Annotated[
-        Path, typer.Option(help="Folder for verify trials, designed gaits and the report.")
-    ] = Path("reports/gait-design"),
+    order: Annotated[int, option("Fourier harmonics per joint.")] = 2,
+    out: Annotated[Path, option("Folder for verify trials, designed gaits and the report.")] = Path(
+        "reports/gait-design"
+    ),
     config: SimConfigOption = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -1084,7 +1052,7 @@ def gait_design(
 
 @command(on=gait_app, name="connection", flags={"half_range": "--range", "learner": "--model"})
 def gait_connection(
-    out: Annotated[Path, typer.Option(help="CSV file; the figure goes beside it (.png).")] = Path(
+    out: Annotated[Path, option("CSV file; the figure goes beside it (.png).")] = Path(
         "reports/gait-connection/learned.csv"
     ),
     prep: PrepOption = None,
@@ -1093,15 +1061,13 @@ def gait_connection(
     grid: GridOption = 21,
     range_: RangeOption = 2.0,
     compare: Annotated[
-        bool, typer.Option("--compare", help="Beside the simulator's connection (locked).")
+        bool, option("Beside the simulator's connection (locked).", "--compare")
     ] = False,
-    gait_file: Annotated[
-        list[Path] | None, typer.Option(help="Gait files to overlay; repeatable.")
-    ] = None,
+    gait_file: Annotated[list[Path] | None, option("Gait files to overlay; repeatable.")] = None,
     directions: Annotated[
         str,
-        typer.Option(
-            help="visited: fit from the shape velocities the data took near each shape; "
+        option(
+            "visited: fit from the shape velocities the data took near each shape; "
             "uniform: from 16 evenly spaced ones."
         ),
     ] = "visited",
@@ -1146,7 +1112,7 @@ plan_app = sub_app(
 )
 app.add_typer(plan_app, name="plan")
 GoalOption = Annotated[
-    str, typer.Option(help="map: learn the map over the target; gait: the best gait in the bound.")
+    str, option("map: learn the map over the target; gait: the best gait in the bound.")
 ]
 
 
@@ -1164,15 +1130,15 @@ def plan_next_cmd(
     goal: GoalOption = "map",
     target: TargetOption = None,
     freqs: TargetFreqsOption = None,
-    bound: Annotated[float, typer.Option(help="Joint bound of a designed gait, rad.")] = 1.3,
-    n: Annotated[int, typer.Option(help="Trials to recommend (map goal).")] = 1,
-    cycles: Annotated[int, typer.Option(help="Cycles per recommended trial.")] = 5,
+    bound: Annotated[float, option("Joint bound of a designed gait, rad.")] = 1.3,
+    n: Annotated[int, option("Trials to recommend (map goal).")] = 1,
+    cycles: Annotated[int, option("Cycles per recommended trial.")] = 5,
     prep: PrepOption = None,
     model: ModelOption = "GMR",
     learner: LearnerAlias = None,
-    out: Annotated[Path, typer.Option(help="Folder for a new gait's file.")] = Path("plan-next"),
-    seed: Annotated[int, typer.Option(help="Seed of the bootstrap refits.")] = 0,
-    boots: Annotated[int, typer.Option(help="Bootstrap refits for the uncertainty.")] = 6,
+    out: Annotated[Path, option("Folder for a new gait's file.")] = Path("plan-next"),
+    seed: Annotated[int, option("Seed of the bootstrap refits.")] = 0,
+    boots: Annotated[int, option("Bootstrap refits for the uncertainty.")] = 6,
     db: DbOption = None,
     json_: JsonOption = False,
 ) -> None:
@@ -1216,20 +1182,16 @@ def plan_next_cmd(
 )
 def plan_loop_cmd(
     goal: GoalOption = "gait",
-    bound: Annotated[float, typer.Option(help="Joint bound |phi1|, |phi2| <= RAD.")] = 1.3,
-    budget_cycles: Annotated[
-        int, typer.Option(help="Cycles the loop may record, its warm-up included.")
-    ] = 50,
-    seed: Annotated[int, typer.Option(help="Seed of the loop (trials and refits).")] = 0,
-    cycles: Annotated[int, typer.Option(help="Cycles per planned trial.")] = 5,
+    bound: Annotated[float, option("Joint bound |phi1|, |phi2| <= RAD.")] = 1.3,
+    budget_cycles: Annotated[int, option("Cycles the loop may record, its warm-up included.")] = 50,
+    seed: Annotated[int, option("Seed of the loop (trials and refits).")] = 0,
+    cycles: Annotated[int, option("Cycles per planned trial.")] = 5,
     target: TargetOption = None,
     freqs: TargetFreqsOption = None,
     prep: PrepOption = None,
     model: ModelOption = "GMR",
     learner: LearnerAlias = None,
-    out: Annotated[Path, typer.Option(help="Folder for the loop's captures and gaits.")] = Path(
-        "plan-loop"
-    ),
+    out: Annotated[Path, option("Folder for the loop's captures and gaits.")] = Path("plan-loop"),
     config: SimConfigOption = None,
     db: DbOption = None,
     json_: JsonOption = False,
@@ -1245,8 +1207,8 @@ def plan_loop_cmd(
     from suds_exp.commands.plan import iteration_line, loop_command, loop_lines, loop_options
     from suds_exp.commands.simulate import build_config
 
-    model = either(model, learner)
-    options = loop_options(goal, bound, budget_cycles, seed, cycles, model, target, freqs)
+    recipe = dict(goal=goal, bound=bound, budget_cycles=budget_cycles, seed=seed, cycles=cycles)
+    options = loop_options(target, freqs, learner=either(model, learner), **recipe)
     say = None if (json_ or quiet) else (lambda it: console.out.print(iteration_line(it)))
     doc = loop_command(
         open_store(db),

@@ -124,6 +124,14 @@ def test_bad_options_are_refused_before_any_work(db, samples):
     assert store.query_df("SELECT count(*) AS n FROM campaigns").n[0] == 0
 
 
+def cli_json(command: str, db: Path) -> dict:
+    """The JSON document of ``suds-exp COMMAND --db DB --json`` (COMMAND's words split on
+    spaces), which must succeed."""
+    out = CliRunner().invoke(cli.app, [*command.split(), "--db", str(db), "--json"])
+    assert out.exit_code == 0, out.output
+    return json.loads(out.stdout)
+
+
 def test_cli_run_and_status(db, samples, monkeypatch):
     import suds_exp.preprocess as preprocess
 
@@ -141,30 +149,11 @@ def test_cli_run_and_status(db, samples, monkeypatch):
 
     monkeypatch.setattr(preprocess, "get_version", fake_get_version)
     runner = CliRunner()
-    args = [
-        "run",
-        "c",
-        "--db",
-        str(db),
-        "--prep",
-        "v1",
-        "--models",
-        "phase-only",
-        "--boots",
-        "1",
-        "--train-cycles",
-        "3",
-        "--train-conditions",
-        "O",
-        "--json",
-    ]
-    out = runner.invoke(cli.app, args)
-    assert out.exit_code == 0, out.output
-    doc = json.loads(out.stdout)
+    doc = cli_json(
+        "run c --prep v1 --models phase-only --boots 1 --train-cycles 3 --train-conditions O", db
+    )
     assert doc["done_now"] == doc["total_jobs"] == 8 and seen == ["v1"]
-    out = runner.invoke(cli.app, ["status", "c", "--db", str(db), "--json"])
-    assert out.exit_code == 0, out.output
-    status = json.loads(out.stdout)
+    status = cli_json("status c", db)
     assert status["done"] == 8 and status["prep"] == "v1" and not status["running"]
     out = runner.invoke(cli.app, ["status", "c", "--db", str(db)])
     assert "8 / 8 jobs done" in out.stdout
@@ -200,24 +189,7 @@ def test_cli_runs_all_five_learners_on_preprocessed_captures(tmp_path, captured)
     db = tmp_path / "e2e.duckdb"
     shutil.copy(captured, db)
     runner = CliRunner()
-    args = [
-        "run",
-        "e2e",
-        "--db",
-        str(db),
-        "--boots",
-        "1",
-        "--train-cycles",
-        "3",
-        "--test-conditions",
-        "O@1",
-        "--sweep",
-        "1",
-        "--json",
-    ]
-    out = runner.invoke(cli.app, args)
-    assert out.exit_code == 0, out.output
-    doc = json.loads(out.stdout)
+    doc = cli_json("run e2e --boots 1 --train-cycles 3 --test-conditions O@1 --sweep 1", db)
     # 4 train x 1 test conditions + the O@1 same-condition sweep point, x 5 learners
     assert doc["done_now"] == doc["total_jobs"] == (4 + 1) * 5 and doc["failed_now"] == 0
     frame = Store(db).query_df("SELECT * FROM results")

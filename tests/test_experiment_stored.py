@@ -35,6 +35,9 @@ name = "frequency_hz"
 kind = "numeric"
 """
 
+#: A campaign small enough for a test: two fast learners, two draws of two cycles.
+SMALL_RUN = ("--models", "phase-only,TLS", "--boots", 2, "--train-cycles", 2)
+
 
 def ok(*args: str) -> str:
     got = runner.invoke(cli.app, [str(a) for a in args])
@@ -77,7 +80,7 @@ def own(tmp_path_factory) -> tuple[Path, Path]:
     manifest = own_manifest(work)
     ok("ingest", "--manifest", manifest, "--experiment", work / "experiment.toml", "--db", db, "-q")
     ok("preprocess", "--db", db, "-q")
-    ok("run", "own", "--models", "phase-only,TLS", "--boots", 2, "--train-cycles", 2, "--db", db)
+    ok("run", "own", *SMALL_RUN, "--db", db)
     return db, work
 
 
@@ -268,18 +271,7 @@ def test_run_report_and_findings_after_verify_on_the_users_design(own_db, tmp_pa
     )
     assert level.level.tolist() == ["design-1-it1.toml"]
     assert "design 1" in level.added_by[0]
-    ok(
-        "run",
-        "after",
-        "--models",
-        "phase-only,TLS",
-        "--boots",
-        2,
-        "--train-cycles",
-        2,
-        "--db",
-        own_db,
-    )
+    ok("run", "after", *SMALL_RUN, "--db", own_db)
     out = tmp_path / "report"
     ok("report", "after", "--out", out, "--db", own_db)
     # its one trial cannot give same-condition pairs: the cells left out are on the page
@@ -343,12 +335,7 @@ def test_a_design_without_same_condition_pairs_reports_the_rest(own, tmp_path):
     ok(
         "run",
         "cross",
-        "--models",
-        "phase-only,TLS",
-        "--boots",
-        2,
-        "--train-cycles",
-        2,
+        *SMALL_RUN,
         "--train-conditions",
         "glide",
         "--test-conditions",

@@ -47,26 +47,15 @@ def next_lines(doc: dict) -> list[str]:
 
 
 def loop_options(
-    goal: str,
-    bound: float,
-    budget_cycles: int,
-    seed: int,
-    cycles: int,
-    learner: str,
-    target: Sequence[Path] | None,
-    freqs: str | None,
+    target: Sequence[Path] | None = None, freqs: str | None = None, **recipe
 ) -> LoopOptions:
-    """`plan loop`'s options as a `LoopOptions` (target frequencies ``freqs`` as
-    "1/2,1"; none: the default target's)."""
+    """`plan loop`'s options as a `LoopOptions`: the target's gait files ``target`` and
+    frequencies ``freqs`` as "1/2,1" (none: the default target's); the rest of the recipe
+    (goal, bound, budget_cycles, seed, cycles, learner, ...) as `LoopOptions` takes it."""
     return LoopOptions(
-        goal=goal,
-        bound=bound,
-        budget_cycles=budget_cycles,
-        seed=seed,
-        cycles=cycles,
-        learner=learner,
         target_files=tuple(str(p) for p in target or ()),
         target_frequencies_hz=parse_freqs(freqs) if freqs else (),
+        **recipe,
     )
 
 
