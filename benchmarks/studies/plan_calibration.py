@@ -2,11 +2,11 @@
 against what the trial then did.
 
 Every gait-goal iteration of `suds-exp plan loop` recommends a gait with a predicted
-forward displacement per cycle (the GMR map's point prediction, mm) and a spread (the
-standard deviation over its bootstrap refits, mm), both kept in the iteration's
-``plan.json``. The trial is then recorded; what it did is its measured forward
-displacement per cycle (`suds_exp.plan.loop.measured_forward`: its own body twists over
-its whole periods). For each planned trial this reads
+forward displacement per cycle (the GMR map's point prediction, mm) and a spread
+(`suds_exp.plan.MapEnsemble.forward`, mm), both kept in the iteration's ``plan.json``.
+The trial is then recorded; what it did is its measured forward displacement per cycle
+(`suds_exp.plan.loop.measured_forward`: its own body twists over its whole periods).
+For each planned trial this reads
 
     z = (measured - predicted) / spread
 

@@ -69,9 +69,9 @@ from suds_exp.plan.ensemble import (
     MapEnsemble,
     jackknife_variance,
     leave_path_out,
+    path_hz,
     recorded_paths,
 )
-from suds_exp.plan.ensemble import path_hz as _path_hz
 from suds_exp.plan.target import Target
 from suds_exp.robot import FREQUENCIES_HZ
 
@@ -169,8 +169,7 @@ def candidate_spacing(gaits: list[Gait], n: int = 64) -> float:
 
 
 def _frequency_weight(a: float, b: float) -> float:
-    # frequencies as stored (6 decimals): 1/3 Hz planned is 0.333333 recorded
-    return 1.0 if round(a, 6) == round(b, 6) else OTHER_FREQUENCY_WEIGHT
+    return 1.0 if path_hz(a) == path_hz(b) else OTHER_FREQUENCY_WEIGHT
 
 
 def recorded_cycles_near(
@@ -285,7 +284,7 @@ def recommend_map(
                 continue
             noise[i] = float(np.sum(per_sample * m / (PRIOR_CYCLES + recorded + m)))
             gait, freq = candidates[i]
-            if (gait.name, _path_hz(freq)) not in covered and worth.min() > 0:
+            if (gait.name, path_hz(freq)) not in covered and worth.min() > 0:
                 w = np.array([_frequency_weight(freq, f) for _, f in pairs])
                 between[i] = float(np.sum(bias * w / (worth + w)))
         removed = noise + between
@@ -306,10 +305,10 @@ def recommend_map(
         # the next pick is scored as if this one were recorded
         per_sample = per_sample * (PRIOR_CYCLES + recorded) / (PRIOR_CYCLES + recorded + m)
         recorded = recorded + m
-        if (gait.name, _path_hz(freq)) not in covered and worth.min() > 0:
+        if (gait.name, path_hz(freq)) not in covered and worth.min() > 0:
             w = np.array([_frequency_weight(freq, f) for _, f in pairs])
             bias = bias * worth / (worth + w)
-            covered = covered + [(gait.name, _path_hz(freq))]
+            covered = covered + [(gait.name, path_hz(freq))]
         taken.add(i)
     return recs
 
