@@ -531,3 +531,29 @@ def test_plan_next_s_gait_spread_counts_the_paths(three_paths, tmp_path, monkeyp
     assert fits == [True]
     (rec,) = advice.recommendations
     assert rec.spread_mm > 0
+
+
+def test_the_stopping_signals_count_recorded_cycles_not_the_phasers_loops(small, three_paths):
+    from suds_exp.plan import MapEnsemble, forecast_signal, learning_curve, plan_next
+    from suds_exp.preprocess import get_version
+
+    store = Store(three_paths)
+    samples = get_version(store, "v1").samples()
+    recorded = plan_next(store, "v1", goal="map", n=1, cycles=10).cycles_total
+    assert recorded == 30  # three trials of 10 cycles
+    # the doubling is of the cycles the user recorded, whatever the phaser counts (it
+    # also counts the part cycles at each trial's ends)
+    signal = forecast_signal(samples, MapEnsemble.fit(samples, n_boot=3, seed=0), Target(), 10)
+    assert signal.cycles[0] == recorded
+    assert f"({recorded} -> " in signal.message
+    # a gait that runs its loop twice a cycle gives the phaser two loops a cycle: the
+    # learning curve's training sizes are still cycles recorded, at most all of them
+    one = get_version(Store(small), "v1").samples()
+    looped = one.assign(cycle=np.floor(2 * one["phase"] / (2 * np.pi)).astype(int))
+    assert looped["cycle"].nunique() > 1.8 * one["cycle"].nunique()
+    for frame in (one, looped):
+        curve = learning_curve(frame)
+        assert curve.cycles[-1] <= 10 and curve.cycles[-1] == pytest.approx(
+            2 * curve.cycles[0], rel=0.2
+        ), curve.message
+        assert "of the 10 recorded" in curve.message, curve.message

@@ -71,7 +71,7 @@ import pandas as pd
 
 from suds_exp.gait.predict import fit_map
 from suds_exp.models.registry import GMR
-from suds_exp.plan.ensemble import MapEnsemble, cycle_blocks
+from suds_exp.plan.ensemble import MapEnsemble, count_cycles, cycle_blocks
 from suds_exp.plan.recommend import bias_variance, recommend_map, recorded_paths
 from suds_exp.plan.target import Target
 
@@ -135,31 +135,36 @@ def learning_curve(samples: pd.DataFrame, learner: str = GMR, seed: int = 0) -> 
     # two sizes are what the signal reads (the last doubling); each costs N_FOLDS fits
     sizes = sorted({max(1, n_train // 2), n_train})
     errors = np.full((N_FOLDS, len(sizes)), np.nan)
+    trained = np.full((N_FOLDS, len(sizes)), np.nan)
     for i, held in enumerate(folds):
         rest = [j for j in order if j not in set(held)]
         test = [blocks[j] for j in held]
         for s, n in enumerate(sizes):
             train = pd.concat([blocks[j] for j in rest[:n]], ignore_index=True)
             errors[i, s] = _rms_vx(fit_map(train, learner), test)
+            trained[i, s] = count_cycles(train)
     mean = errors.mean(axis=0)
     spread = errors.std(axis=0, ddof=1) / np.sqrt(N_FOLDS)
     drop = float(mean[-2] - mean[-1]) if len(sizes) > 1 else None
-    # training sizes in cycles: a block is one cycle
-    cycles = [float(n) for n in sizes]
+    # training sizes in the cycles the user recorded (mean over folds), not in blocks
+    cycles = [float(c) for c in trained.mean(axis=0)]
+    doubling = (
+        f"the last doubling of cycles ({cycles[0]:.0f} -> {cycles[-1]:.0f} of the "
+        f"{count_cycles(samples):.0f} recorded, the rest held out)"
+    )
     if drop is None:
         stop, message = False, "too few cycles for two training sizes: record more"
     elif drop < spread[-1]:
         stop = True
         message = (
-            f"stop: the last doubling of cycles ({sizes[-2]} -> {sizes[-1]}) lowered the "
-            f"held-out error by {drop:.2f} mm/s, less than its spread {spread[-1]:.2f} mm/s; "
-            "more data of this kind will not help"
+            f"stop: {doubling} lowered the held-out error by {drop:.2f} mm/s, less than its "
+            f"spread {spread[-1]:.2f} mm/s; more data of this kind will not help"
         )
     else:
         stop = False
         message = (
-            f"continue: the last doubling of cycles ({sizes[-2]} -> {sizes[-1]}) lowered the "
-            f"held-out error by {drop:.2f} mm/s, more than its spread {spread[-1]:.2f} mm/s"
+            f"continue: {doubling} lowered the held-out error by {drop:.2f} mm/s, more than "
+            f"its spread {spread[-1]:.2f} mm/s"
         )
     return StopSignal(stop, message, cycles, mean.tolist(), spread.tolist(), drop)
 
@@ -185,7 +190,8 @@ def target_signal(
             [],
             None,
         )
-    first = fit_map(pd.concat(blocks[:half], ignore_index=True), learner)
+    first_half = pd.concat(blocks[:half], ignore_index=True)
+    first = fit_map(first_half, learner)
     sq = []
     for g, f in target.pairs():
         a, b = first.motion(g, f), ensemble.point.motion(g, f)
@@ -193,7 +199,8 @@ def target_signal(
     change = float(np.sqrt(np.mean(sq)))
     variance = [ensemble.displacement_spread([g], f)[0] for g, f in target.pairs()]
     spread = float(np.sqrt(np.mean(variance)))
-    doubling = f"the last doubling of cycles ({half} -> {len(blocks)})"
+    sizes = [count_cycles(first_half), count_cycles(samples)]
+    doubling = f"the last doubling of cycles ({sizes[0]:.0f} -> {sizes[1]:.0f})"
     if change < spread:
         stop, message = (
             True,
@@ -211,7 +218,7 @@ def target_signal(
                 f"cycle, more than their bootstrap spread {spread:.2f} mm"
             ),
         )
-    return StopSignal(stop, message, [float(half), float(len(blocks))], [], [], None,
+    return StopSignal(stop, message, sizes, [], [], None,
                       change, spread)  # fmt: skip
 
 
@@ -318,9 +325,9 @@ def removable_share(half: Doubling, before_now_mm: float) -> float:
 
 def _forecast(samples, ensemble, target, cycles, learner, bias, seed):
     """The uncalibrated `Doubling` of ``samples`` (see `forecast_signal`), the trials
-    planned for it and the cycle blocks recorded."""
+    planned for it and the cycles recorded (`count_cycles`, rounded)."""
     pairs = target.pairs()
-    n = len(cycle_blocks(samples))
+    n = round(count_cycles(samples))
     trials = max(1, round(n / cycles))
     if bias is None:
         bias = bias_variance(samples, target, learner, ensemble.point)

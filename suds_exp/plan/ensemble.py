@@ -41,6 +41,25 @@ def cycle_blocks(samples: pd.DataFrame) -> list[pd.DataFrame]:
     return [b for _, b in samples.groupby(["trial_id", "cycle"], sort=True)]
 
 
+def count_cycles(samples: pd.DataFrame) -> float:
+    """Gait cycles a samples frame holds, as the user recorded them: per trial, its
+    samples' span in time (samples x the median sampling interval, s) x its frequency
+    (Hz), summed. A trial of unknown frequency counts its cycle blocks instead.
+
+    Not the number of cycle blocks: the phaser counts loops of the shape path, so a gait
+    that runs its loop twice a cycle gives two blocks a cycle, and each trial's part
+    cycles at its ends are blocks of their own."""
+    total = 0.0
+    for _, trial in samples.groupby("trial_id", sort=False):
+        frequency = float(trial["frequency_hz"].iloc[0])
+        t = np.sort(trial["t"].to_numpy(float))
+        if not np.isfinite(frequency) or len(t) < 2:
+            total += trial["cycle"].nunique()
+            continue
+        total += len(t) * float(np.median(np.diff(t))) * frequency
+    return total
+
+
 def block_draws(samples: pd.DataFrame, n_boot: int, seed: int):
     """``n_boot`` samples frames, each the cycle blocks of ``samples`` resampled with
     replacement (draw b seeded by (seed, b)); each drawn block is a series of its own,

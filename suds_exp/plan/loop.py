@@ -47,7 +47,7 @@ from suds_exp.ingest.added import mark_trials_added
 from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
 from suds_exp.plan.curve import forecast_signal, latched, learning_curve
-from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
+from suds_exp.plan.ensemble import N_BOOT, MapEnsemble, count_cycles
 from suds_exp.plan.recommend import (
     Recommendation,
     Trial,
@@ -259,11 +259,8 @@ class _LazyTruth:
 
 
 def version_cycles(samples: pd.DataFrame) -> int:
-    """Cycles in a samples frame: each trial's duration x frequency, rounded, summed."""
-    total = 0.0
-    for _, t in samples.groupby("trial_id"):
-        total += (t["t"].max() - t["t"].min()) * float(t["frequency_hz"].iloc[0])
-    return int(round(total))
+    """Cycles recorded in a samples frame (`count_cycles`), rounded."""
+    return int(round(count_cycles(samples)))
 
 
 def _recorded_gaits(samples: pd.DataFrame, folder: Path) -> tuple[list[str], list[Gait]]:
