@@ -557,3 +557,24 @@ def test_the_stopping_signals_count_recorded_cycles_not_the_phasers_loops(small,
             2 * curve.cycles[0], rel=0.2
         ), curve.message
         assert "of the 10 recorded" in curve.message, curve.message
+
+
+def test_plan_next_compares_with_every_recorded_gait_wherever_its_out_is(gait_loop, tmp_path):
+    db, loop = gait_loop
+    copy = tmp_path / "g.duckdb"
+    shutil.copy(db, copy)
+    designed = loop.iterations[1].trial["gait"]
+    # a loop records each gait file beside its capture: plan next finds it there, not
+    # only in its own --out folder
+    doc = json.loads(
+        ok("plan", "next", "--goal", "gait", "--bound", "1.2", "--out", str(tmp_path / "x"),
+           "--boots", "2", "--db", str(copy), "--json")
+    )  # fmt: skip
+    assert doc["recorded_gaits"] == sorted(["O", designed]) and doc["notes"] == []
+    # a gait file found nowhere is named, not silently left out of "the best recorded gait"
+    with Store(copy).write() as conn:
+        conn.exec_driver_sql("UPDATE trials SET gait = 'lost.toml' WHERE gait = ?", (designed,))
+    printed = ok("plan", "next", "--goal", "gait", "--bound", "1.2", "--out",
+                 str(tmp_path / "x"), "--boots", "2", "--db", str(copy))  # fmt: skip
+    assert f"note: recorded gait file(s) not found in {tmp_path / 'x'}" in printed
+    assert printed.split("note:", 1)[1].splitlines()[0].endswith("compared with: lost.toml")

@@ -41,6 +41,7 @@ def next_lines(doc: dict) -> list[str]:
             f"{i}. record {t['gait']} at {t['frequency_hz']:g} Hz for {t['cycles']} cycles: "
             f"{rec['reason']}"
         )
+    lines += [f"note: {note}" for note in doc.get("notes", [])]
     if doc["stop"]:
         lines.append(doc["stop"]["message"])
     return lines

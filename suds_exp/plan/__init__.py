@@ -10,7 +10,8 @@ Public face (the CLI's `plan next | loop` are thin faces on these):
 - `MapEnsemble` (`ensemble`): a learner, its cycle-bootstrap refits and its
   path-jackknife refits, the uncertainty every plan reads; `forecast_signal` (the map
   goal's stopping signal), `learning_curve`, `target_signal` (`curve`); `Target`,
-  `unseen_gaits` (`target`).
+  `unseen_gaits` (`target`); `recorded_gaits` (`recorded`): the gaits a version's
+  trials ran, found by their files' names.
 """
 
 from suds_exp.plan.advise import Advice, plan_next
@@ -18,6 +19,7 @@ from suds_exp.plan.curve import StopSignal, forecast_signal, learning_curve, tar
 from suds_exp.plan.ensemble import MapEnsemble
 from suds_exp.plan.loop import Loop, LoopIteration, LoopOptions, load_loop, run_loop
 from suds_exp.plan.recommend import Recommendation, Trial
+from suds_exp.plan.recorded import RecordedGaits, recorded_gaits
 from suds_exp.plan.target import GOALS, Target, TargetTruth, unseen_gaits
 
 __all__ = [
@@ -28,6 +30,7 @@ __all__ = [
     "LoopOptions",
     "MapEnsemble",
     "Recommendation",
+    "RecordedGaits",
     "StopSignal",
     "Target",
     "TargetTruth",
@@ -36,6 +39,7 @@ __all__ = [
     "forecast_signal",
     "load_loop",
     "plan_next",
+    "recorded_gaits",
     "run_loop",
     "target_signal",
     "unseen_gaits",

@@ -13,13 +13,14 @@ from suds_exp.models import make_model
 from suds_exp.models.registry import GMR
 from suds_exp.plan.curve import StopSignal, forecast_signal, learning_curve
 from suds_exp.plan.ensemble import N_BOOT, MapEnsemble
-from suds_exp.plan.loop import TRUST0, _recorded_gaits, check_body, version_cycles
+from suds_exp.plan.loop import TRUST0, check_body, version_cycles
 from suds_exp.plan.recommend import (
     Recommendation,
     bias_variance,
     recommend_gait,
     recommend_map,
 )
+from suds_exp.plan.recorded import recorded_gaits
 from suds_exp.plan.target import GOALS, Target
 from suds_exp.preprocess import get_version
 from suds_exp.store import Store
@@ -28,7 +29,9 @@ from suds_exp.store import Store
 @dataclass
 class Advice:
     """What `plan_next` returns: the version, its cycles, the recommendations (best
-    first) and the stopping signal."""
+    first) and the stopping signal. The gait goal also names the recorded gaits it
+    compared with (``recorded_gaits``) and, in ``notes``, the recorded gait files it could
+    not find."""
 
     prep_version: int
     goal: str
@@ -36,6 +39,8 @@ class Advice:
     recommendations: list[Recommendation] = field(default_factory=list)
     stop: StopSignal | None = None
     files: list[str] = field(default_factory=list)
+    recorded_gaits: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {
@@ -44,6 +49,8 @@ class Advice:
             "cycles_total": self.cycles_total,
             "recommendations": [r.to_dict() for r in self.recommendations],
             "files": self.files,
+            "recorded_gaits": self.recorded_gaits,
+            "notes": self.notes,
             "stop": self.stop.to_dict() if self.stop else None,
         }
 
@@ -94,10 +101,17 @@ def plan_next(
     else:
         out = Path(out)
         name = f"plan-v{version.id}-{key % 10**6:06d}.toml"
+        known = recorded_gaits(samples, out, store)
+        advice.recorded_gaits = known.labels
+        if known.missing:
+            advice.notes.append(
+                f"recorded gait file(s) not found in {out} or beside their captures, so not "
+                f"compared with: {', '.join(known.missing)}"
+            )
         rec, _, _ = recommend_gait(
             ensemble,
             Support.of(samples),
-            _recorded_gaits(samples, out)[1],
+            known.gaits,
             target,
             trust,
             cycles,

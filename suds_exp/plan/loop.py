@@ -56,6 +56,7 @@ from suds_exp.plan.recommend import (
     recommend_map,
 )
 from suds_exp.plan.record import add_trial_to_version, record_trial
+from suds_exp.plan.recorded import recorded_gaits
 from suds_exp.plan.target import GOALS, Target, TargetTruth
 from suds_exp.preprocess import get_version
 from suds_exp.preprocess import preprocess as run_preprocess
@@ -216,7 +217,8 @@ class _State:
         paths = opts.goal == "gait"
         self.ensemble = MapEnsemble.fit(self.samples, opts.learner, opts.n_boot, seed, paths)
         self.support = Support.of(self.samples)
-        labels, self.gaits = _recorded_gaits(self.samples, folder)
+        known = recorded_gaits(self.samples, folder, store)
+        labels, self.gaits = known.labels, known.gaits
         freq = target.frequencies_hz[0]
         preds = [self.ensemble.point.forward(g, freq) for g in self.gaits]
         # the trust rule's baseline: the map's own best, so its gains are the map's
@@ -261,24 +263,6 @@ class _LazyTruth:
 def version_cycles(samples: pd.DataFrame) -> int:
     """Cycles recorded in a samples frame (`count_cycles`), rounded."""
     return int(round(count_cycles(samples)))
-
-
-def _recorded_gaits(samples: pd.DataFrame, folder: Path) -> tuple[list[str], list[Gait]]:
-    """The gaits the version's trials ran that the planner knows, with their trials' gait
-    labels: the paper's gaits and the gait files under ``folder`` (a loop's, or those
-    `plan next` wrote there and the user recorded), matched by name; at least the
-    paper's O."""
-    files = {p.name: p for p in folder.glob("**/*.toml")}
-    labels, gaits = [], []
-    for label in sorted(set(samples["gait"].dropna().astype(str))):
-        if label in GAITS:
-            gaits.append(NamedGait(label))
-        elif label in files:
-            gaits.append(read_gait_file(files[label]))
-        else:
-            continue
-        labels.append(label)
-    return (labels, gaits) if gaits else (["O"], [NamedGait("O")])
 
 
 def measured_forward(samples: pd.DataFrame, frequency_hz: float) -> dict[str, float]:
