@@ -578,3 +578,15 @@ def test_plan_next_compares_with_every_recorded_gait_wherever_its_out_is(gait_lo
                  str(tmp_path / "x"), "--boots", "2", "--db", str(copy))  # fmt: skip
     assert f"note: recorded gait file(s) not found in {tmp_path / 'x'}" in printed
     assert printed.split("note:", 1)[1].splitlines()[0].endswith("compared with: lost.toml")
+
+
+def test_the_map_criterion_counts_recorded_cycles_not_the_phasers_loops(small):
+    from suds_exp.plan.recommend import recorded_cycles_near
+    from suds_exp.preprocess import get_version
+
+    one = get_version(Store(small), "v1").samples()
+    looped = one.assign(cycle=np.floor(2 * one["phase"] / (2 * np.pi)).astype(int))
+    near = recorded_cycles_near(one, Target())
+    np.testing.assert_allclose(recorded_cycles_near(looped, Target()), near)
+    # ten cycles recorded: no target sample is near more of them
+    assert near.max() <= 10.0 + 1e-9

@@ -67,6 +67,7 @@ from suds_exp.gait.support import SHAPE_RADIUS, Support, actuated_columns, direc
 from suds_exp.models.registry import GMR
 from suds_exp.plan.ensemble import (
     MapEnsemble,
+    count_cycles,
     jackknife_variance,
     leave_path_out,
     path_hz,
@@ -189,7 +190,7 @@ def recorded_cycles_near(
     for _, trial in samples.groupby("trial_id"):
         feats = direction_features(trial[ra_cols].to_numpy(float), trial[dra_cols].to_numpy(float))
         tree = cKDTree(feats)
-        cycles = float(trial["cycle"].nunique())
+        cycles = count_cycles(trial)
         freq = float(trial["frequency_hz"].iloc[0])
         for k, ((_, f), path) in enumerate(zip(pairs, paths, strict=True)):
             near = nearness(tree.query(path)[0], scale)
