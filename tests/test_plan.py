@@ -557,6 +557,10 @@ def test_the_stopping_signals_count_recorded_cycles_not_the_phasers_loops(small,
             2 * curve.cycles[0], rel=0.2
         ), curve.message
         assert "of the 10 recorded" in curve.message, curve.message
+    # a trial of unknown frequency can only count the phaser's cycle blocks
+    from suds_exp.plan.ensemble import count_cycles
+
+    assert count_cycles(one.assign(frequency_hz=None)) == one["cycle"].nunique()
 
 
 def test_plan_next_compares_with_every_recorded_gait_wherever_its_out_is(gait_loop, tmp_path):

@@ -51,7 +51,7 @@ def count_cycles(samples: pd.DataFrame) -> float:
     cycles at its ends are blocks of their own."""
     total = 0.0
     for _, trial in samples.groupby("trial_id", sort=False):
-        frequency = float(trial["frequency_hz"].iloc[0])
+        frequency = float(pd.to_numeric(trial["frequency_hz"], errors="coerce").iloc[0])
         t = np.sort(trial["t"].to_numpy(float))
         if not np.isfinite(frequency) or len(t) < 2:
             total += trial["cycle"].nunique()
