@@ -15,6 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 from suds_exp.gait.shape import Gait, NamedGait, read_gait_file
+from suds_exp.ingest.manifest import GAIT_FILE_SUFFIXES
 from suds_exp.robot import GAITS
 from suds_exp.store import Store
 
@@ -45,7 +46,9 @@ def recorded_gaits(
 ) -> RecordedGaits:
     """The gaits the trials of ``samples`` ran (see the module docstring): gait files
     under ``folder`` (any depth) or, with ``store``, beside the trials' capture files."""
-    found = {p.name: p for p in Path(folder).glob("**/*")} if Path(folder).is_dir() else {}
+    found = {
+        p.name: p for suffix in GAIT_FILE_SUFFIXES for p in Path(folder).glob(f"**/*{suffix}")
+    }
     beside = capture_folders(store, samples["trial_id"].unique()) if store is not None else []
     labels, gaits, missing = [], [], []
     for label in sorted(set(samples["gait"].dropna().astype(str))):
