@@ -123,3 +123,15 @@ def script_parser(
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--quick", action="store_true", help=quick)
     return parser
+
+
+def comparison_parser(
+    description: str, baseline: str, rounds: int, rounds_flag: str = "--rounds"
+) -> argparse.ArgumentParser:
+    """`script_parser` with a commit comparison's options: ``--baseline`` (default
+    ``baseline``; a commit, or a checkout's folder, as `baseline_tree` takes it) and
+    ``rounds_flag`` (default ``rounds``: rounds a side, as `alternate` runs them)."""
+    parser = script_parser(description)
+    parser.add_argument("--baseline", default=baseline)
+    parser.add_argument(rounds_flag, type=int, default=rounds)
+    return parser
