@@ -129,8 +129,8 @@ def comparison_parser(
     description: str, baseline: str, rounds: int, rounds_flag: str = "--rounds"
 ) -> argparse.ArgumentParser:
     """`script_parser` with a commit comparison's options: ``--baseline`` (default
-    ``baseline``; a commit, or a checkout's folder, as `baseline_tree` takes it) and
-    ``rounds_flag`` (default ``rounds``: rounds a side, as `alternate` runs them)."""
+    ``baseline``: the commit the working tree is measured against; `alternate` also takes
+    a checkout's folder) and ``rounds_flag`` (default ``rounds``: rounds a side)."""
     parser = script_parser(description)
     parser.add_argument("--baseline", default=baseline)
     parser.add_argument(rounds_flag, type=int, default=rounds)
