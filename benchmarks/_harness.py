@@ -123,3 +123,15 @@ def script_parser(
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--quick", action="store_true", help=quick)
     return parser
+
+
+def comparison_parser(
+    description: str, baseline: str, rounds: int, rounds_flag: str = "--rounds"
+) -> argparse.ArgumentParser:
+    """`script_parser` with a commit comparison's options: ``--baseline`` (default
+    ``baseline``: the commit the working tree is measured against; `alternate` also takes
+    a checkout's folder) and ``rounds_flag`` (default ``rounds``: rounds a side)."""
+    parser = script_parser(description)
+    parser.add_argument("--baseline", default=baseline)
+    parser.add_argument(rounds_flag, type=int, default=rounds)
+    return parser

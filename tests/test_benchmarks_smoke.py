@@ -32,8 +32,10 @@ def test_every_script_sits_in_a_box_and_takes_quick():
     assert len(SCRIPTS) > 20
     for module in SCRIPTS:
         text = (ROOT / (module.replace(".", "/") + ".py")).read_text()
-        # the harness's script_parser declares --quick for the scripts that use it
-        assert '"--quick"' in text or "script_parser(" in text, f"{module} has no --quick"
+        # the harness's parsers declare --quick for the scripts that use them
+        assert re.search(r'"--quick"|\b(script|comparison)_parser\(', text), (
+            f"{module} has no --quick"
+        )
         assert re.search(rf"python3? -m {re.escape(module)}\b", text), (
             f"{module}'s docstring does not say how to run it"
         )

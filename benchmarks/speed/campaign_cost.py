@@ -47,7 +47,7 @@ from pathlib import Path
 from statistics import median
 
 from benchmarks import _data
-from benchmarks._harness import alternate, same, script_parser, worker
+from benchmarks._harness import alternate, comparison_parser, same, worker
 
 #: A smoke run's sizes: trial cycles, training cycles, learners.
 QUICK = (8, 5, ["phase-only", "TLS"])
@@ -159,9 +159,7 @@ def _figures(r: dict) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = script_parser(__doc__.splitlines()[0])
-    ap.add_argument("--baseline", default="3454561")
-    ap.add_argument("--rounds", type=int, default=3)
+    ap = comparison_parser(__doc__.splitlines()[0], "3454561", 3)
     ap.add_argument("--boots", type=int, default=1)
     ap.add_argument("--sweep", default="1,4,16,30,48")
     ap.add_argument("--writes", type=int, default=0, help="time N batch writes instead")

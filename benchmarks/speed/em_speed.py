@@ -29,7 +29,7 @@ from threadpoolctl import threadpool_limits
 
 import suds_exp.models.gmr as gmr_module
 from benchmarks import _data
-from benchmarks._harness import ROOT, script_parser
+from benchmarks._harness import ROOT, comparison_parser
 from suds_exp.models import make_model
 from suds_exp.models import mixture as new
 
@@ -72,9 +72,7 @@ def em_inputs(n_draws: int = 4, cycles: int = 30, trial_cycles: int = 25) -> lis
 
 
 def main(argv=None) -> int:
-    ap = script_parser(__doc__.splitlines()[0])
-    ap.add_argument("--baseline", default="c2aa7be")
-    ap.add_argument("--rounds", type=int, default=7)
+    ap = comparison_parser(__doc__.splitlines()[0], "c2aa7be", 7)
     a = ap.parse_args(argv)
     k, sizes = 16, {}
     if a.quick:

@@ -38,7 +38,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import ROOT, alternate, run_in, same, script_parser, speedup, worker
+from benchmarks._harness import ROOT, alternate, comparison_parser, run_in, same, speedup, worker
 
 #: The design's options beside the learner and --verify (the default test's design).
 DESIGN = ["--bound", "1.3", "--iterations", "2", "--order", "1"]
@@ -131,9 +131,7 @@ def _runner(cases: list[str]):
 
 
 def main(argv=None) -> int:
-    ap = script_parser(__doc__.splitlines()[0])
-    ap.add_argument("--baseline", default="650de56")
-    ap.add_argument("--rounds", type=int, default=3)
+    ap = comparison_parser(__doc__.splitlines()[0], "650de56", 3)
     ap.add_argument("--cases", nargs="+", choices=list(CASES), default=list(DEFAULT_CASES))
     ap.add_argument("--worker", choices=list(CASES), help=argparse.SUPPRESS)
     a = ap.parse_args(argv)

@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import ROOT, alternate, script_parser
+from benchmarks._harness import ROOT, alternate, comparison_parser
 
 COMMANDS = {
     "--version": ["--version"],
@@ -61,9 +61,7 @@ def _database(folder: Path) -> Path:
 
 
 def main(argv=None) -> int:
-    ap = script_parser(__doc__.splitlines()[0])
-    ap.add_argument("--baseline", default="HEAD")
-    ap.add_argument("--repeats", type=int, default=5)
+    ap = comparison_parser(__doc__.splitlines()[0], "HEAD", 5, rounds_flag="--repeats")
     a = ap.parse_args(argv)
     commands = COMMANDS
     if a.quick:

@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 from statistics import median
 
-from benchmarks._harness import ROOT, alternate, same, script_parser, worker
+from benchmarks._harness import ROOT, alternate, comparison_parser, same, worker
 
 CASES = ("new database", "first write", "read")
 
@@ -83,9 +83,7 @@ def _run(tree: Path, repeats: int) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = script_parser(__doc__.splitlines()[0])
-    ap.add_argument("--baseline", default="b16e0d5")
-    ap.add_argument("--rounds", type=int, default=3)
+    ap = comparison_parser(__doc__.splitlines()[0], "b16e0d5", 3)
     ap.add_argument("--repeats", type=int, default=15)
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
