@@ -16,6 +16,7 @@ import pandas as pd
 
 from suds_exp.gait.shape import Gait, NamedGait, read_gait_file
 from suds_exp.ingest.manifest import GAIT_FILE_SUFFIXES
+from suds_exp.preprocess.pipeline import trial_meta
 from suds_exp.robot import GAITS
 from suds_exp.store import Store
 
@@ -33,12 +34,9 @@ class RecordedGaits:
 
 def capture_folders(store: Store, trial_ids) -> list[Path]:
     """The folders of the capture files of trials ``trial_ids`` (distinct, sorted)."""
-    ids = sorted({int(i) for i in trial_ids})
-    if not ids:
-        return []
-    marks = ", ".join("?" * len(ids))
-    files = store.query_df(f"SELECT DISTINCT source_file FROM trials WHERE id IN ({marks})", ids)
-    return sorted({Path(f).parent for f in files["source_file"].dropna().astype(str)})
+    with store.read() as conn:
+        files = trial_meta(conn, trial_ids, ("id", "source_file"))["source_file"]
+    return sorted({Path(f).parent for f in files.dropna().astype(str)})
 
 
 def recorded_gaits(
@@ -58,7 +56,7 @@ def recorded_gaits(
             path = found.get(label) or next(
                 (f / label for f in beside if (f / label).is_file()), None
             )
-            if path is None or not path.is_file():
+            if path is None:
                 missing.append(label)
                 continue
             gaits.append(read_gait_file(path))
